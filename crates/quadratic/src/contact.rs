@@ -1,0 +1,594 @@
+//! The earliest contact time of two balls (disks in 2D, spheres in 3D) in uniform motion.
+//!
+//! # The question
+//!
+//! Ball *i* is at `rᵢ + vᵢ·t` with radius `Rᵢ`. With `Δr = r₂ − r₁`, `Δv = v₂ − v₁`,
+//! `σ = R₁ + R₂`, they touch when `|Δr + Δv·t|² = σ²`, i.e. (seed eq. 5–7)
+//!
+//! `a·t² + 2b·t + c = 0`, with `a = |Δv|²`, `b = ⟨Δv | Δr⟩`, `c = |Δr|² − σ²`.
+//!
+//! # Semantics
+//!
+//! | condition (exact, on the f64 inputs) | answer |
+//! |---|---|
+//! | `Δv = 0` | [`Contact::Never`]`(`[`Miss::NoRelativeMotion`]`)` |
+//! | `b ≥ 0`: separating, or tangential — even when overlapping | `Never(`[`Miss::Receding`]`)` |
+//! | `b < 0` and `c ≤ 0`: approaching while touching or overlapping | [`Contact::Now`] (`t = 0`) |
+//! | `b < 0`, `c > 0`, `D ≤ 0`: the paths miss, or only graze | `Never(`[`Miss::PathsMiss`]`)` |
+//! | `b < 0`, `c > 0`, `D > 0` | [`Contact::At`]`(t)`, `t = c / (−b + √D)` |
+//!
+//! where `D = b² − a·c` is, by the Lagrange identity, `D = |Δv|²·σ² − |Δr ∧ Δv|²`
+//! (in 2D `Δr ∧ Δv = Δx·Δv_y − Δy·Δv_x`; in 3D the cross product). This form has no
+//! `|Δr|²` terms to cancel, and `t = c / (−b + √D)` is the smaller root written without
+//! cancellation (both terms of the denominator are positive). An exact graze (`D = 0`)
+//! is a miss: the normal relative velocity vanishes at the touching instant, so there is
+//! nothing to resolve. Two balls of zero radius never collide (their contact would be a
+//! graze).
+//!
+//! # Accuracy contract
+//!
+//! * The classification (never / now / at) is **exact** for the exact values of the f64
+//!   inputs: `Δr`, `Δv` and `σ` are formed without rounding (TwoSum), and every sign is
+//!   either certified by a rigorous error bound or computed exactly with expansions.
+//! * `t` is **within one ulp** of the exact contact time of the f64 inputs (not of rounded
+//!   `a`, `b`, `c`); a contact time beyond `f64::MAX` is `+∞`, one below the smallest
+//!   subnormal is the smallest subnormal (so `At(t)` always has `t > 0`).
+//!
+//! Both hold whenever the differences can be scaled by powers of two without loss: lengths
+//! are scaled by one power of two and velocities by another, so any overall scale works;
+//! only a component more than about 2⁹⁰⁰ times smaller than the largest of its kind can lose
+//! bits (to underflow) — far outside any physical configuration, and documented here rather
+//! than hidden.
+//!
+//! # Speed
+//!
+//! The answer is first computed in f64 and double-double with rigorous error bounds (a
+//! "filter", as in Shewchuk's adaptive predicates); only when a bound cannot certify a sign,
+//! or the inputs leave the range `2^±150` where the bounds are proved, does the exact
+//! expansion path run. Typical simulation pairs never reach it.
+
+use crate::exact::{Dd, Expansion, exponent, pow2, scale2, two_prod, two_sum};
+use core::cmp::Ordering;
+use core::fmt;
+
+/// A ball in uniform motion: position, velocity and radius, in any consistent units.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Ball<const D: usize> {
+    /// Position at `t = 0`.
+    pub position: [f64; D],
+    /// Constant velocity.
+    pub velocity: [f64; D],
+    /// Radius (≥ 0).
+    pub radius: f64,
+}
+
+/// Why two balls never touch while approaching.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Miss {
+    /// `Δv = 0` exactly: their distance never changes.
+    NoRelativeMotion,
+    /// `⟨Δv | Δr⟩ ≥ 0`: separating or moving tangentially (also when overlapping).
+    Receding,
+    /// Approaching, but the closest approach is at or beyond contact (`D ≤ 0`).
+    PathsMiss,
+}
+
+/// When two balls first touch while approaching.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Contact {
+    /// Never, and why.
+    Never(Miss),
+    /// Approaching and already touching or overlapping: collide at `t = 0`.
+    Now,
+    /// First contact at this time, `t > 0`.
+    At(f64),
+}
+
+impl Contact {
+    /// The contact time: `None` for never, `Some(0.0)` for now.
+    pub fn time(&self) -> Option<f64> {
+        match *self {
+            Contact::Never(_) => None,
+            Contact::Now => Some(0.0),
+            Contact::At(t) => Some(t),
+        }
+    }
+}
+
+/// Which input of [`contact_time`] is at fault.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Field {
+    /// Component `i` of the position.
+    Position(usize),
+    /// Component `i` of the velocity.
+    Velocity(usize),
+    /// The radius.
+    Radius,
+}
+
+/// Why [`contact_time`] refused its input.
+#[non_exhaustive]
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum ContactError {
+    /// A NaN or infinite input.
+    NonFinite {
+        /// 1 or 2: which ball.
+        ball: u8,
+        /// Which field.
+        field: Field,
+        /// The value.
+        value: f64,
+    },
+    /// A negative radius.
+    NegativeRadius {
+        /// 1 or 2: which ball.
+        ball: u8,
+        /// The value.
+        value: f64,
+    },
+}
+
+impl fmt::Display for ContactError {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        let name = |ball: u8, field: Field| match field {
+            Field::Position(i) => format!("r{ball}[{i}]"),
+            Field::Velocity(i) => format!("v{ball}[{i}]"),
+            Field::Radius => format!("R{ball}"),
+        };
+        match *self {
+            ContactError::NonFinite { ball, field, value } => {
+                write!(f, "{} = {value} is not finite", name(ball, field))
+            }
+            ContactError::NegativeRadius { ball, value } => {
+                write!(f, "R{ball} = {value} is negative; a radius must be ≥ 0")
+            }
+        }
+    }
+}
+
+impl std::error::Error for ContactError {}
+
+/// The earliest contact of two balls; see the [module docs](self) for semantics and contract.
+///
+/// ```
+/// use quadratic::{contact_time, Ball, Contact, Miss};
+/// let a = Ball { position: [0.0, 0.0], velocity: [1.0, 0.0], radius: 0.5 };
+/// let b = Ball { position: [3.0, 0.0], velocity: [-1.0, 0.0], radius: 0.5 };
+/// assert_eq!(contact_time(&a, &b), Ok(Contact::At(1.0)));
+/// let c = Ball { position: [3.0, 0.0], velocity: [1.0, 0.0], radius: 0.5 };
+/// assert_eq!(contact_time(&a, &c), Ok(Contact::Never(Miss::NoRelativeMotion)));
+/// ```
+pub fn contact_time<const D: usize>(
+    first: &Ball<D>,
+    second: &Ball<D>,
+) -> Result<Contact, ContactError> {
+    for (ball, b) in [(1u8, first), (2u8, second)] {
+        for i in 0..D {
+            for (field, value) in [
+                (Field::Position(i), b.position[i]),
+                (Field::Velocity(i), b.velocity[i]),
+            ] {
+                if !value.is_finite() {
+                    return Err(ContactError::NonFinite { ball, field, value });
+                }
+            }
+        }
+        if !b.radius.is_finite() {
+            return Err(ContactError::NonFinite {
+                ball,
+                field: Field::Radius,
+                value: b.radius,
+            });
+        }
+        if b.radius < 0.0 {
+            return Err(ContactError::NegativeRadius {
+                ball,
+                value: b.radius,
+            });
+        }
+    }
+    Ok(contact_time_unchecked(first, second))
+}
+
+/// A length or velocity difference held exactly as `hi + lo` (TwoSum output).
+type Pair = (f64, f64);
+
+/// A power of two that keeps `x − y` and `x + y` finite: `2⁻⁴` when some magnitude is
+/// near the top of the range, else 1. (Scaling down may drop subnormal bits of *other*
+/// inputs — 2²⁰⁰⁰ times smaller than the largest, see the contract.)
+fn prescale(max_abs: f64) -> i32 {
+    if max_abs >= pow2(1020) { -4 } else { 0 }
+}
+
+/// [`contact_time`] for inputs already known to be finite with non-negative radii.
+pub fn contact_time_unchecked<const D: usize>(first: &Ball<D>, second: &Ball<D>) -> Contact {
+    let lmax = first
+        .position
+        .iter()
+        .chain(&second.position)
+        .fold(first.radius.max(second.radius), |m, x| m.max(x.abs()));
+    let vmax = first
+        .velocity
+        .iter()
+        .chain(&second.velocity)
+        .fold(0.0f64, |m, x| m.max(x.abs()));
+    let (lpre, vpre) = (prescale(lmax), prescale(vmax));
+    let len = |x: f64| if lpre == 0 { x } else { scale2(x, lpre) };
+    let vel = |x: f64| if vpre == 0 { x } else { scale2(x, vpre) };
+
+    let mut dr = [(0.0, 0.0); D];
+    let mut dv = [(0.0, 0.0); D];
+    for i in 0..D {
+        dr[i] = two_sum(len(second.position[i]), -len(first.position[i]));
+        dv[i] = two_sum(vel(second.velocity[i]), -vel(first.velocity[i]));
+    }
+    let sigma = two_sum(len(first.radius), len(second.radius));
+    contact_of_differences(&dr, &dv, sigma, vpre - lpre, true)
+}
+
+/// The exact (expansion) path alone, bypassing the filter: for the tests that prove both
+/// paths against the oracle, and for the benchmarks. Inputs as for [`contact_time_unchecked`].
+#[doc(hidden)]
+pub fn contact_time_exact_path<const D: usize>(first: &Ball<D>, second: &Ball<D>) -> Contact {
+    let mut dr = [(0.0, 0.0); D];
+    let mut dv = [(0.0, 0.0); D];
+    let lmax = first
+        .position
+        .iter()
+        .chain(&second.position)
+        .fold(first.radius.max(second.radius), |m, x| m.max(x.abs()));
+    let vmax = first
+        .velocity
+        .iter()
+        .chain(&second.velocity)
+        .fold(0.0f64, |m, x| m.max(x.abs()));
+    let (lpre, vpre) = (prescale(lmax), prescale(vmax));
+    for i in 0..D {
+        dr[i] = two_sum(
+            scale2(second.position[i], lpre),
+            -scale2(first.position[i], lpre),
+        );
+        dv[i] = two_sum(
+            scale2(second.velocity[i], vpre),
+            -scale2(first.velocity[i], vpre),
+        );
+    }
+    let sigma = two_sum(scale2(first.radius, lpre), scale2(second.radius, lpre));
+    contact_of_differences(&dr, &dv, sigma, vpre - lpre, false)
+}
+
+/// The contact given exact differences `Δr`, `Δv`, `σ` as (hi, lo) pairs; the resulting time
+/// is multiplied by `2^time_exp`.
+fn contact_of_differences<const D: usize>(
+    dr: &[Pair; D],
+    dv: &[Pair; D],
+    sigma: Pair,
+    time_exp: i32,
+    use_filter: bool,
+) -> Contact {
+    // Δv = 0 exactly iff every TwoSum head is 0.
+    let vmax = dv.iter().fold(0.0f64, |m, p| m.max(p.0.abs()));
+    if vmax == 0.0 {
+        return Contact::Never(Miss::NoRelativeMotion);
+    }
+    let lmax = dr.iter().fold(sigma.0, |m, p| m.max(p.0.abs()));
+    if lmax == 0.0 {
+        // Δr = 0 and σ = 0: b = 0, tangential.
+        return Contact::Never(Miss::Receding);
+    }
+    let range = pow2(-150)..=pow2(150);
+    if use_filter && time_exp == 0 && range.contains(&lmax) && range.contains(&vmax) {
+        if let Some(contact) = filtered(dr, dv, sigma) {
+            return contact;
+        }
+    }
+    // Scale lengths and velocities separately to magnitude [1, 2): exact (but for the
+    // underflow caveat in the contract), and the time scales by 2^(el − ev).
+    let (el, ev) = (exponent(lmax), exponent(vmax));
+    let sp = |p: Pair, k: i32| (scale2(p.0, k), scale2(p.1, k));
+    let dr = dr.map(|p| sp(p, -el));
+    let dv = dv.map(|p| sp(p, -ev));
+    exact(&dr, &dv, sp(sigma, -el), time_exp + el - ev)
+}
+
+// ---------------------------------------------------------------------------------------
+// The filter: f64 signs, then double-double values, each with a rigorous error bound.
+// ---------------------------------------------------------------------------------------
+
+/// Unit roundoff u = 2⁻⁵³.
+const U: f64 = f64::EPSILON / 2.0;
+/// Absolute slack covering underflow in the filter: every f64 operation on inputs in
+/// `2^±150` errs by at most 2⁻¹⁰⁷⁵ absolutely through underflow; a few hundred such
+/// operations stay far below 2⁻¹⁰⁰⁰.
+const SLACK: f64 = 1e-300;
+/// A double-double value is used for the root only when its certified relative error is
+/// below 2⁻⁸⁰ — then the root is correctly rounded unless within ~2⁻²⁵ ulp of a midpoint.
+/// Its bound is ~2⁻⁹⁸ of the scale below, so values above 2⁻¹⁸ of the scale qualify.
+const DD_ACCEPT: f64 = 1.0 / (1u64 << 18) as f64;
+
+/// The certified answer, or `None` when the exact path must decide.
+///
+/// Notation: `Δrᵢ = hᵢ + lᵢ`, `Δvᵢ = gᵢ + mᵢ`, `σ = s + t`, with `|lᵢ| ≤ u|hᵢ|` (and alike),
+/// all of `|hᵢ|, s, |gᵢ|` in `2^±150` (checked by the caller), u = 2⁻⁵³.
+#[inline]
+fn filtered<const D: usize>(dr: &[Pair; D], dv: &[Pair; D], sigma: Pair) -> Option<Contact> {
+    // --- b = ⟨Δv|Δr⟩ in f64. With P = Σ|hᵢgᵢ|: the FMA chain errs by ≤ D·u·P(1+Du) and
+    // the dropped terms hᵢmᵢ + lᵢgᵢ + lᵢmᵢ by ≤ (2u + u²)P; (D + 3)·u·P covers both.
+    let mut b = 0.0;
+    let mut p = 0.0;
+    for i in 0..D {
+        b = dr[i].0.mul_add(dv[i].0, b);
+        p += (dr[i].0 * dv[i].0).abs();
+    }
+    let bound_b = (D as f64 + 4.0) * U * p + SLACK;
+    if b > bound_b {
+        return Some(Contact::Never(Miss::Receding));
+    }
+    if b >= -bound_b {
+        return None;
+    }
+    // --- c = |Δr|² − σ². With Q = Σhᵢ² + s²: chain error ≤ (D + 1)·u·Q, dropped
+    // 2hᵢlᵢ + lᵢ² − 2st − t² ≤ (2u + u²)·Q.
+    let (s, st) = sigma;
+    let mut c = -(s * s);
+    let mut q = s * s;
+    for h in dr.iter().map(|p| p.0) {
+        c = h.mul_add(h, c);
+        q = h.mul_add(h, q);
+    }
+    let bound_c = (D as f64 + 5.0) * U * q + SLACK;
+    if c < -bound_c {
+        return Some(Contact::Now);
+    }
+    if c <= bound_c {
+        return None;
+    }
+    // --- D = |Δv|²σ² − Σ_{i<j}(ΔrᵢΔvⱼ − ΔrⱼΔvᵢ)². With Xᵢⱼ = |hᵢgⱼ| + |hⱼgᵢ| and
+    // A = a·s² + ΣXᵢⱼ²: each factor errs by a few u relative to its own scale (a by
+    // (D + 3)u, s² by 3u, each cross term by 4u·Xᵢⱼ), so 32·u·A bounds the total for D ≤ 3.
+    let mut a = 0.0;
+    for g in dv.iter().map(|p| p.0) {
+        a = g.mul_add(g, a);
+    }
+    let asig = a * (s * s);
+    let mut disc = asig;
+    let mut scale = asig;
+    for i in 0..D {
+        for j in i + 1..D {
+            let (hi, hj, gi, gj) = (dr[i].0, dr[j].0, dv[i].0, dv[j].0);
+            let cross = hi.mul_add(gj, -(hj * gi));
+            let x = (hi * gj).abs() + (hj * gi).abs();
+            disc = (-cross).mul_add(cross, disc);
+            scale = x.mul_add(x, scale);
+        }
+    }
+    let bound_d = 32.0 * U * scale + SLACK;
+    if disc < -bound_d {
+        return Some(Contact::Never(Miss::PathsMiss));
+    }
+    if disc <= bound_d {
+        return None;
+    }
+    // --- All three signs certified: b < 0, c > 0, D > 0. Now the values, in double-double.
+    // Each is an exact sum of TwoProd heads plus small terms accumulated in f64; its error is
+    // below 2⁻⁹⁸ of the scale (P, Q or A: a dozen terms each ≤ 2u·scale, summed with error
+    // ≤ u each, plus the TwoProd tails' own rounding), so accepting values ≥ 2⁻¹⁸·scale
+    // bounds the relative error by 2⁻⁸⁰.
+    if -b < DD_ACCEPT * p || c < DD_ACCEPT * q || disc < DD_ACCEPT * scale {
+        return None;
+    }
+    let neg_b = {
+        let mut acc = Acc::default();
+        for i in 0..D {
+            let ((h, l), (g, m)) = (dr[i], dv[i]);
+            acc.prod(-h, g);
+            acc.small(-(h.mul_add(m, l * g) + l * m));
+        }
+        acc.dd()
+    };
+    let c_dd = {
+        let mut acc = Acc::default();
+        acc.prod(-s, s);
+        acc.small(-(2.0 * s).mul_add(st, st * st));
+        for &(h, l) in dr {
+            acc.prod(h, h);
+            acc.small((2.0 * h).mul_add(l, l * l));
+        }
+        acc.dd()
+    };
+    let d_dd = {
+        let mut a_acc = Acc::default();
+        for &(g, m) in dv {
+            a_acc.prod(g, g);
+            a_acc.small((2.0 * g).mul_add(m, m * m));
+        }
+        let mut s_acc = Acc::default();
+        s_acc.prod(s, s);
+        s_acc.small((2.0 * s).mul_add(st, st * st));
+        let asig = a_acc.dd().mul(s_acc.dd());
+        let mut acc = Acc::default();
+        acc.prod(asig.hi, 1.0);
+        acc.small(asig.lo);
+        for i in 0..D {
+            for j in i + 1..D {
+                let ((hi, li), (gi, mi)) = (dr[i], dv[i]);
+                let ((hj, lj), (gj, mj)) = (dr[j], dv[j]);
+                let mut x = Acc::default();
+                x.prod(hi, gj);
+                x.prod(-hj, gi);
+                x.small(hi.mul_add(mj, li * gj) - hj.mul_add(mi, lj * gi) + (li * mj - lj * mi));
+                let cross = x.dd();
+                let sq = cross.mul(cross);
+                acc.prod(-sq.hi, 1.0);
+                acc.small(-sq.lo);
+            }
+        }
+        acc.dd()
+    };
+    let den = neg_b.add(d_dd.sqrt());
+    let t = c_dd.div(den);
+    Some(Contact::At(t.hi + t.lo))
+}
+
+/// A double-double accumulator: heads summed exactly by TwoSum, tails in plain f64.
+#[derive(Default)]
+struct Acc {
+    hi: f64,
+    lo: f64,
+}
+
+impl Acc {
+    /// Adds `x·y` (exactly split by TwoProd).
+    #[inline(always)]
+    fn prod(&mut self, x: f64, y: f64) {
+        let (p, e) = two_prod(x, y);
+        let (s, f) = two_sum(self.hi, p);
+        self.hi = s;
+        self.lo += f + e;
+    }
+    /// Adds a small term (already below the heads by a factor ~u).
+    #[inline(always)]
+    fn small(&mut self, x: f64) {
+        self.lo += x;
+    }
+    #[inline(always)]
+    fn dd(&self) -> Dd {
+        Dd::new(self.hi, self.lo)
+    }
+}
+
+// ---------------------------------------------------------------------------------------
+// The exact path: expansions, on inputs scaled to magnitude [1, 2).
+// ---------------------------------------------------------------------------------------
+
+fn exact<const D: usize>(dr: &[Pair; D], dv: &[Pair; D], sigma: Pair, time_exp: i32) -> Contact {
+    let ex = |p: Pair| Expansion::from_pair(p.0, p.1);
+    let drx: Vec<Expansion> = dr.iter().map(|&p| ex(p)).collect();
+    let dvx: Vec<Expansion> = dv.iter().map(|&p| ex(p)).collect();
+    let sx = ex(sigma);
+
+    let mut b = Expansion::default();
+    for i in 0..D {
+        b = b.add(&drx[i].mul(&dvx[i]));
+    }
+    if b.sign() != Ordering::Less {
+        return Contact::Never(Miss::Receding);
+    }
+    let mut c = sx.mul(&sx).neg();
+    for x in &drx {
+        c = c.add(&x.mul(x));
+    }
+    if c.sign() != Ordering::Greater {
+        return Contact::Now;
+    }
+    let mut a = Expansion::default();
+    for x in &dvx {
+        a = a.add(&x.mul(x));
+    }
+    let mut crosses = Vec::with_capacity(D * (D - 1) / 2);
+    for i in 0..D {
+        for j in i + 1..D {
+            crosses.push(drx[i].mul(&dvx[j]).sub(&drx[j].mul(&dvx[i])).compress());
+        }
+    }
+    // D = aσ² − Σ cross² is homogeneous of degree 2 in lengths: evaluate it at lengths scaled
+    // by 2^k so that max(σ, |cross|) ~ 1 — otherwise tiny radii (σ² below the subnormal range)
+    // would turn a head-on hit into a graze.
+    let m = crosses.iter().fold(sigma.0, |m, x| m.max(x.magnitude()));
+    let k = if m == 0.0 { 0 } else { (-exponent(m)).max(0) };
+    let sk = sx.scale2(k);
+    let mut disc = a.mul(&sk.mul(&sk));
+    for x in &crosses {
+        let xk = x.scale2(k);
+        disc = disc.sub(&xk.mul(&xk));
+    }
+    if disc.sign() != Ordering::Greater {
+        return Contact::Never(Miss::PathsMiss);
+    }
+    let root = disc.to_dd().sqrt();
+    let root = Dd {
+        hi: scale2(root.hi, -k),
+        lo: scale2(root.lo, -k),
+    };
+    let t = c.to_dd().div(b.neg().to_dd().add(root));
+    Contact::At(t.to_f64_scaled(time_exp).max(f64::from_bits(1)))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn ball(position: [f64; 2], velocity: [f64; 2], radius: f64) -> Ball<2> {
+        Ball {
+            position,
+            velocity,
+            radius,
+        }
+    }
+
+    /// Runs both paths (the filter where it applies, and the exact one) and checks they agree.
+    fn both(p: &Ball<2>, q: &Ball<2>) -> Contact {
+        let fast = contact_time(p, q).unwrap();
+        assert_eq!(
+            fast,
+            contact_time_exact_path(p, q),
+            "filter and exact path disagree"
+        );
+        fast
+    }
+
+    #[test]
+    fn head_on_and_classification_cases() {
+        let a = ball([0.0, 0.0], [1.0, 0.0], 0.5);
+        assert_eq!(
+            both(&a, &ball([3.0, 0.0], [-1.0, 0.0], 0.5)),
+            Contact::At(1.0)
+        );
+        assert_eq!(
+            both(&a, &ball([3.0, 0.0], [2.0, 0.0], 0.5)),
+            Contact::Never(Miss::Receding)
+        );
+        assert_eq!(
+            both(&a, &ball([3.0, 5.0], [-1.0, 0.0], 0.5)),
+            Contact::Never(Miss::PathsMiss)
+        );
+        // Exact graze: impact parameter equals σ = 1.
+        assert_eq!(
+            both(&a, &ball([3.0, 1.0], [-1.0, 0.0], 0.5)),
+            Contact::Never(Miss::PathsMiss)
+        );
+        // Overlapping and approaching: now; overlapping and separating: never.
+        assert_eq!(both(&a, &ball([0.5, 0.0], [-1.0, 0.0], 0.5)), Contact::Now);
+        assert_eq!(
+            both(&a, &ball([0.5, 0.0], [3.0, 0.0], 0.5)),
+            Contact::Never(Miss::Receding)
+        );
+        // Touching exactly and approaching.
+        assert_eq!(both(&a, &ball([1.0, 0.0], [0.0, 0.0], 0.5)), Contact::Now);
+    }
+
+    #[test]
+    fn tiny_radii_head_on_still_hit() {
+        let r = scale2(1.0, -700);
+        let p = ball([0.0, 0.0], [0.0, 0.0], r);
+        let q = ball([1.0, 1.0], [-1.0, -1.0], r);
+        // t = 1 − σ/|Δr| with σ = 2^-699, |Δr| = √2: rounds to 1 − 2⁻⁵³ or 1.
+        let t = both(&p, &q).time().unwrap();
+        assert!(t == 1.0 || t == 1.0 - U, "{t}");
+    }
+
+    #[test]
+    fn errors_name_the_field() {
+        let mut p = ball([0.0, 0.0], [0.0, 0.0], 1.0);
+        let q = ball([0.0, 0.0], [0.0, 0.0], 1.0);
+        p.velocity[1] = f64::NAN;
+        let e = contact_time(&p, &q).unwrap_err();
+        assert_eq!(e.to_string(), "v1[1] = NaN is not finite");
+        let q = ball([0.0, 0.0], [0.0, 0.0], -2.0);
+        let p = ball([0.0, 0.0], [0.0, 0.0], 1.0);
+        assert!(matches!(
+            contact_time(&p, &q),
+            Err(ContactError::NegativeRadius { ball: 2, .. })
+        ));
+    }
+}

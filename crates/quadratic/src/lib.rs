@@ -1,0 +1,48 @@
+//! Verified real roots of `a·x² + b·x + c = 0` and exact contact times of moving balls, in f64.
+//!
+//! # Overview
+//!
+//! * [`solve`] returns every real root of a quadratic with finite f64 coefficients as a
+//!   [`Roots`] (none, one, two ascending, or all x). The root count is exact and every
+//!   root is within one ulp of the exact root of the f64-valued coefficients.
+//! * [`contact_time`] returns when two [`Ball`]s (disks in 2D, spheres in 3D; any `D`)
+//!   first touch while approaching, as a [`Contact`] (never — and why —, now, or at `t`).
+//!   The never/now/at classification is exact for the f64 inputs and `t` is within one
+//!   ulp of the exact contact time of those inputs — not of rounded `a`, `b`, `c`.
+//! * [`exact`] holds the error-free building blocks (TwoSum, FMA TwoProd, Shewchuk
+//!   expansions, double-double); [`hex`] reads and writes C99 hex floats; [`textbook`]
+//!   is the seed's naive formula, kept only for comparison.
+//!
+//! Data flows one way: f64 inputs → exact differences (TwoSum) → certified f64 /
+//! double-double evaluation, or exact expansions when a bound cannot decide → one rounding.
+//! Nothing allocates except the rare exact path. No dependencies, no `unsafe`.
+//!
+//! The crate's `README.md` is the edge-case reference: one row per hard case with the
+//! textbook answer, this crate's answer and the exact one.
+//!
+//! # Example
+//!
+//! ```
+//! use quadratic::{contact_time, solve, Ball, Contact, Roots};
+//!
+//! // Cancellation: the textbook formula returns 0 for the small root of x² − 1e9·x + 1.
+//! assert_eq!(solve(1.0, -1e9, 1.0), Ok(Roots::Two(1e-9, 1e9)));
+//!
+//! // Two unit disks 1e9 apart at large coordinates, head on: exact differences, exact time.
+//! let p = Ball { position: [1e9, 0.0], velocity: [0.5, 0.0], radius: 0.5 };
+//! let q = Ball { position: [2e9 + 1.0, 0.0], velocity: [-0.5, 0.0], radius: 0.5 };
+//! assert_eq!(contact_time(&p, &q), Ok(Contact::At(1e9)));
+//! ```
+#![forbid(unsafe_code)]
+#![warn(missing_docs)]
+
+pub mod contact;
+pub mod exact;
+pub mod hex;
+pub mod roots;
+pub mod textbook;
+
+#[doc(hidden)]
+pub use contact::contact_time_exact_path;
+pub use contact::{Ball, Contact, ContactError, Field, Miss, contact_time};
+pub use roots::{Coefficient, Roots, SolveError, solve};

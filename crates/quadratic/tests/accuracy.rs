@@ -1,0 +1,205 @@
+//! The accuracy contracts, proved family by family against the exact oracle, and the
+//! seed's textbook formula measured on the same cases for comparison.
+//!
+//! Each family runs as a proptest property with a fixed seed (`common::runner`): a
+//! violation of the contract fails the test with the shrunk counterexample. While the
+//! properties run, the same cases are scored for the table printed at the end (and written
+//! to `target/tmp/accuracy-table.md`): misclassifications and max ulp error, for collide
+//! and for the textbook formula. The table documents; only collide's columns are asserted.
+
+mod common;
+
+use common::families::{contact_families, contact_families_3d, quadratic_families};
+use common::oracle::{check_roots, class3, exact_contact};
+use common::runner;
+use proptest::prelude::*;
+use proptest::strategy::BoxedStrategy;
+use quadratic::{Ball, Contact, textbook};
+use std::cell::RefCell;
+
+/// Cases per family. The contract is a worst-case claim, so more is better; 20 000 per
+/// family keeps the whole file to a few seconds in release.
+const CASES: u32 = 20_000;
+
+#[derive(Default, Clone)]
+struct Score {
+    cases: usize,
+    wrong: usize,
+    max_ulps: f64,
+    textbook_wrong: usize,
+    textbook_over_1ulp: usize,
+    textbook_max_ulps: f64,
+}
+
+fn row(name: &str, s: &Score) -> String {
+    format!(
+        "| {name} | {} | {} | {:.3} | {} ({:.1} %) | {} | {} |",
+        s.cases,
+        s.wrong,
+        s.max_ulps,
+        s.textbook_wrong,
+        100.0 * s.textbook_wrong as f64 / s.cases as f64,
+        s.textbook_over_1ulp,
+        fmt_ulps(s.textbook_max_ulps)
+    )
+}
+
+fn fmt_ulps(u: f64) -> String {
+    if u.is_infinite() {
+        "∞".into()
+    } else if u >= 1e4 {
+        format!("{u:.1e}")
+    } else {
+        format!("{u:.2}")
+    }
+}
+
+const HEADER: &str = "| family | cases | collide: wrong count/class | collide: max ulp | textbook: wrong count/class | textbook: > 1 ulp | textbook: max ulp |\n|---|---|---|---|---|---|---|";
+
+fn publish(title: &str, rows: &[String]) {
+    let table = format!("### {title}\n\n{HEADER}\n{}\n", rows.join("\n"));
+    println!("{table}");
+    let dir = std::path::Path::new(env!("CARGO_TARGET_TMPDIR"));
+    let path = dir.join(format!(
+        "accuracy-{}.md",
+        title.split_whitespace().next().unwrap().to_lowercase()
+    ));
+    std::fs::write(path, &table).unwrap();
+}
+
+#[test]
+fn quadratic_solver_contract_on_every_family() {
+    let mut rows = Vec::new();
+    for (name, strategy) in quadratic_families() {
+        let score = RefCell::new(Score::default());
+        let result = runner(CASES).run(&strategy, |(a, b, c)| {
+            let got = quadratic::solve(a, b, c).expect("finite inputs");
+            let check = check_roots(a, b, c, &got);
+            let naive = check_roots(a, b, c, &textbook::solve(a, b, c));
+            let mut s = score.borrow_mut();
+            s.cases += 1;
+            s.wrong += usize::from(!check.count_ok);
+            s.max_ulps = s
+                .max_ulps
+                .max(if check.count_ok { check.max_ulps } else { 0.0 });
+            if naive.count_ok {
+                s.textbook_over_1ulp += usize::from(!(naive.max_ulps <= 1.0));
+                s.textbook_max_ulps = s.textbook_max_ulps.max(naive.max_ulps);
+            } else {
+                s.textbook_wrong += 1;
+            }
+            drop(s);
+            prop_assert!(
+                check.count_ok,
+                "wrong root count for ({a:e}, {b:e}, {c:e}): {got:?}"
+            );
+            prop_assert!(
+                check.max_ulps <= 1.0,
+                "({a:e}, {b:e}, {c:e}) → {got:?}: {} ulp from the exact root",
+                check.max_ulps
+            );
+            Ok(())
+        });
+        if let Err(e) = result {
+            panic!("family '{name}': {e}");
+        }
+        rows.push(row(name, &score.into_inner()));
+    }
+    publish("Quadratic solver", &rows);
+}
+
+fn score_contacts<const D: usize>(
+    families: Vec<(&'static str, BoxedStrategy<(Ball<D>, Ball<D>)>)>,
+) -> Vec<String> {
+    let mut rows = Vec::new();
+    for (name, strategy) in families {
+        let score = RefCell::new(Score::default());
+        let result = runner(CASES).run(&strategy, |(p, q)| {
+            let got = quadratic::contact_time(&p, &q).expect("valid inputs");
+            // The exact path alone must give the identical answer: both paths are proved.
+            let slow = quadratic::contact_time_exact_path(&p, &q);
+            prop_assert_eq!(
+                got,
+                slow,
+                "filter and exact path disagree for {:?} {:?}",
+                p,
+                q
+            );
+            let exact = exact_contact(&p, &q);
+            let naive = textbook::contact_time(&p, &q);
+            let ulps = |c: &Contact| match *c {
+                Contact::At(t) => exact.ulps(t),
+                _ => 0.0,
+            };
+            let class_ok = std::mem::discriminant(&got) == std::mem::discriminant(&exact.class)
+                && (matches!(got, Contact::At(_)) || got == exact.class);
+            let u = if class_ok { ulps(&got) } else { 0.0 };
+            let mut s = score.borrow_mut();
+            s.cases += 1;
+            s.wrong += usize::from(!class_ok);
+            s.max_ulps = s.max_ulps.max(u);
+            if class3(&naive) == class3(&exact.class) {
+                let nu = ulps(&naive);
+                s.textbook_over_1ulp += usize::from(!(nu <= 1.0));
+                s.textbook_max_ulps = s.textbook_max_ulps.max(nu);
+            } else {
+                s.textbook_wrong += 1;
+            }
+            drop(s);
+            prop_assert!(
+                class_ok,
+                "{p:?} {q:?}: got {got:?}, exact {:?}",
+                exact.class
+            );
+            prop_assert!(
+                u <= 1.0,
+                "{p:?} {q:?}: {got:?} is {u} ulp from the exact time"
+            );
+            Ok(())
+        });
+        if let Err(e) = result {
+            panic!("family '{name}': {e}");
+        }
+        rows.push(row(name, &score.into_inner()));
+    }
+    rows
+}
+
+#[test]
+fn contact_time_contract_on_every_family_2d() {
+    publish("Contact time (2D)", &score_contacts(contact_families()));
+}
+
+#[test]
+fn contact_time_contract_on_every_family_3d() {
+    publish("Contact time (3D)", &score_contacts(contact_families_3d()));
+}
+
+/// The oracle itself must be able to fail: answers moved by 2 ulps, or misclassified,
+/// are caught.
+#[test]
+fn oracle_detects_wrong_answers() {
+    use common::families::nudge;
+    // x² − 3x + 2: roots 1, 2. Two ulps off is 2 ulps off; a missing root is a count error.
+    let c = check_roots(1.0, -3.0, 2.0, &quadratic::Roots::Two(1.0, nudge(2.0, 2)));
+    assert!(c.count_ok && c.max_ulps >= 1.9, "{c:?}");
+    assert!(!check_roots(1.0, -3.0, 2.0, &quadratic::Roots::One(1.0)).count_ok);
+    // Double root at 3: one root expected, two is wrong.
+    assert!(!check_roots(1.0, -6.0, 9.0, &quadratic::Roots::Two(3.0, 3.0)).count_ok);
+    // A head-on contact at t = 1: t ± 2 ulps is caught, and the class is exact.
+    let p = Ball {
+        position: [0.0, 0.0],
+        velocity: [1.0, 0.0],
+        radius: 0.5,
+    };
+    let q = Ball {
+        position: [3.0, 0.0],
+        velocity: [-1.0, 0.0],
+        radius: 0.5,
+    };
+    let exact = exact_contact(&p, &q);
+    assert_eq!(class3(&exact.class), 2);
+    assert!(exact.ulps(1.0) < 1e-9);
+    assert!(exact.ulps(nudge(1.0, 2)) >= 1.9);
+    assert!(exact.ulps(nudge(1.0, -2)) >= 1.9);
+}
