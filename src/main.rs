@@ -1,1 +1,214 @@
-fn main() {}
+//! The `collide` command line: argument parsing and error display only; the work is in the
+//! library.
+
+use anyhow::{Context, Result, bail};
+use clap::{Args, Parser, Subcommand};
+use collide::io::numbers::{NumberFormat, format_text, parse_text};
+use collide::io::query::{Query, answer_lines, contact_time_dyn};
+use collide::quadratic::Roots;
+use std::io::{self, BufWriter};
+use std::process::ExitCode;
+
+#[derive(Parser)]
+#[command(
+    name = "collide",
+    version,
+    about = "Event-driven hard-disk dynamics on verified collision numerics"
+)]
+struct Cli {
+    #[command(subcommand)]
+    command: Option<Command>,
+}
+
+#[derive(Subcommand)]
+enum Command {
+    /// Checks the numerics on this machine against the built-in edge-case reference
+    /// (the default when no command is given); exits non-zero on any mismatch.
+    Check,
+    /// Real roots of a·x² + b·x + c = 0: prints them ascending on one line, "none", or "all".
+    Roots(RootsArgs),
+    /// Earliest contact time of two disks (or spheres): prints the time, or "never".
+    ContactTime(ContactArgs),
+}
+
+#[derive(Args)]
+struct Output {
+    /// Read JSON lines on stdin, answer one line each on stdout.
+    #[arg(long)]
+    jsonl: bool,
+    /// Write numbers as exact C99 hex floats (0x1.8p+1) instead of shortest decimals.
+    #[arg(long)]
+    hex: bool,
+}
+
+impl Output {
+    fn format(&self) -> NumberFormat {
+        if self.hex {
+            NumberFormat::Hex
+        } else {
+            NumberFormat::Shortest
+        }
+    }
+}
+
+#[derive(Args)]
+struct RootsArgs {
+    #[command(flatten)]
+    output: Output,
+    /// The coefficients a b c (decimal or hex float; omit with --jsonl).
+    #[arg(allow_hyphen_values = true, num_args = 3, value_names = ["A", "B", "C"])]
+    coefficients: Vec<String>,
+}
+
+#[derive(Args)]
+struct ContactArgs {
+    #[command(flatten)]
+    output: Output,
+    /// Position of disk 1, "x,y" (or "x,y,z").
+    #[arg(long, allow_hyphen_values = true)]
+    r1: Option<String>,
+    /// Velocity of disk 1.
+    #[arg(long, allow_hyphen_values = true)]
+    v1: Option<String>,
+    /// Radius of disk 1.
+    #[arg(long = "R1", allow_hyphen_values = true)]
+    radius1: Option<String>,
+    /// Position of disk 2.
+    #[arg(long, allow_hyphen_values = true)]
+    r2: Option<String>,
+    /// Velocity of disk 2.
+    #[arg(long, allow_hyphen_values = true)]
+    v2: Option<String>,
+    /// Radius of disk 2.
+    #[arg(long = "R2", allow_hyphen_values = true)]
+    radius2: Option<String>,
+}
+
+fn main() -> ExitCode {
+    let cli = Cli::parse();
+    match run(cli) {
+        Ok(code) => code,
+        Err(e) => {
+            eprintln!("collide: {e:#}");
+            ExitCode::from(2)
+        }
+    }
+}
+
+fn run(cli: Cli) -> Result<ExitCode> {
+    match cli.command.unwrap_or(Command::Check) {
+        Command::Check => check(),
+        Command::Roots(args) => roots(args),
+        Command::ContactTime(args) => contact(args),
+    }
+}
+
+fn check() -> Result<ExitCode> {
+    let report = collide::quadratic::reference::check_all();
+    print!("{}", report.text);
+    if report.failures == 0 {
+        println!(
+            "all {} reference cases agree with the exact answers",
+            report.cases
+        );
+        Ok(ExitCode::SUCCESS)
+    } else {
+        eprintln!(
+            "collide: {} of {} reference cases disagree with the exact answers",
+            report.failures, report.cases
+        );
+        Ok(ExitCode::FAILURE)
+    }
+}
+
+/// Runs the JSON-lines protocol; exit status 1 if any line could not be answered.
+fn jsonl(query: Query, format: NumberFormat) -> Result<ExitCode> {
+    let stdin = io::stdin().lock();
+    let stdout = BufWriter::new(io::stdout().lock());
+    let failed = answer_lines(query, stdin, stdout, io::stderr().lock(), format)
+        .context("reading stdin or writing stdout")?;
+    if failed > 0 {
+        eprintln!("collide: {failed} line(s) could not be answered");
+        return Ok(ExitCode::FAILURE);
+    }
+    Ok(ExitCode::SUCCESS)
+}
+
+fn roots(args: RootsArgs) -> Result<ExitCode> {
+    let format = args.output.format();
+    if args.output.jsonl {
+        if !args.coefficients.is_empty() {
+            bail!("give either --jsonl or the coefficients A B C, not both");
+        }
+        return jsonl(Query::Roots, format);
+    }
+    let [a, b, c] = match args.coefficients.as_slice() {
+        [a, b, c] => [a, b, c],
+        _ => bail!("expected three coefficients A B C (or --jsonl); see collide roots --help"),
+    };
+    let num = |name: &str, s: &str| parse_text(s).with_context(|| format!("coefficient {name}"));
+    let roots = collide::quadratic::solve(num("A", a)?, num("B", b)?, num("C", c)?)?;
+    println!(
+        "{}",
+        match roots {
+            Roots::None => "none".to_string(),
+            Roots::All => "all".to_string(),
+            other => other
+                .as_vec()
+                .iter()
+                .map(|&x| format_text(x, format))
+                .collect::<Vec<_>>()
+                .join(" "),
+        }
+    );
+    Ok(ExitCode::SUCCESS)
+}
+
+fn contact(args: ContactArgs) -> Result<ExitCode> {
+    let format = args.output.format();
+    let given = [
+        &args.r1,
+        &args.v1,
+        &args.radius1,
+        &args.r2,
+        &args.v2,
+        &args.radius2,
+    ];
+    if args.output.jsonl {
+        if given.iter().any(|x| x.is_some()) {
+            bail!("give either --jsonl or the options --r1 --v1 --R1 --r2 --v2 --R2, not both");
+        }
+        return jsonl(Query::ContactTime, format);
+    }
+    let need = |value: &Option<String>, name: &str| -> Result<String> {
+        value.clone().with_context(|| {
+            format!(
+                "missing --{name} (all of --r1 --v1 --R1 --r2 --v2 --R2 are needed, or --jsonl)"
+            )
+        })
+    };
+    let vector = |value: &Option<String>, name: &str| -> Result<Vec<f64>> {
+        need(value, name)?
+            .split(',')
+            .enumerate()
+            .map(|(i, s)| parse_text(s).with_context(|| format!("--{name} component {i}")))
+            .collect()
+    };
+    let scalar = |value: &Option<String>, name: &str| -> Result<f64> {
+        parse_text(&need(value, name)?).with_context(|| format!("--{name}"))
+    };
+    let t = contact_time_dyn(
+        &vector(&args.r1, "r1")?,
+        &vector(&args.v1, "v1")?,
+        scalar(&args.radius1, "R1")?,
+        &vector(&args.r2, "r2")?,
+        &vector(&args.v2, "v2")?,
+        scalar(&args.radius2, "R2")?,
+    )
+    .map_err(anyhow::Error::msg)?;
+    println!(
+        "{}",
+        t.map_or_else(|| "never".to_string(), |t| format_text(t, format))
+    );
+    Ok(ExitCode::SUCCESS)
+}

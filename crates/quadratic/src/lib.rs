@@ -39,6 +39,7 @@
 pub mod contact;
 pub mod exact;
 pub mod hex;
+pub mod reference;
 pub mod roots;
 pub mod textbook;
 

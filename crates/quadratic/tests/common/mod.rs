@@ -3,6 +3,7 @@ pub mod oracle;
 
 use proptest::test_runner::{Config, RngAlgorithm, TestRng, TestRunner};
 
+#[allow(dead_code)]
 /// A proptest runner with a fixed seed: the same cases on every machine and every run.
 pub fn runner(cases: u32) -> TestRunner {
     let config = Config {

@@ -1,0 +1,5 @@
+//! Everything that touches text: exact number parsing and formatting, and the JSON-lines
+//! query protocol of `collide roots` and `collide contact-time`.
+
+pub mod numbers;
+pub mod query;
