@@ -162,6 +162,22 @@ pub fn contact_time<const D: usize>(
     first: &Ball<D>,
     second: &Ball<D>,
 ) -> Result<Contact, ContactError> {
+    // Branch-free screen: x·0 is ±0 for finite x and NaN otherwise.
+    let mut z = first.radius * 0.0 + second.radius * 0.0;
+    for i in 0..D {
+        z += first.position[i] * 0.0 + second.position[i] * 0.0;
+        z += first.velocity[i] * 0.0 + second.velocity[i] * 0.0;
+    }
+    if z == 0.0 && first.radius >= 0.0 && second.radius >= 0.0 {
+        Ok(contact_time_unchecked(first, second))
+    } else {
+        Err(first_invalid(first, second))
+    }
+}
+
+/// The first offending input (cold path of [`contact_time`]).
+#[cold]
+fn first_invalid<const D: usize>(first: &Ball<D>, second: &Ball<D>) -> ContactError {
     for (ball, b) in [(1u8, first), (2u8, second)] {
         for i in 0..D {
             for (field, value) in [
@@ -169,60 +185,47 @@ pub fn contact_time<const D: usize>(
                 (Field::Velocity(i), b.velocity[i]),
             ] {
                 if !value.is_finite() {
-                    return Err(ContactError::NonFinite { ball, field, value });
+                    return ContactError::NonFinite { ball, field, value };
                 }
             }
         }
         if !b.radius.is_finite() {
-            return Err(ContactError::NonFinite {
+            return ContactError::NonFinite {
                 ball,
                 field: Field::Radius,
                 value: b.radius,
-            });
+            };
         }
         if b.radius < 0.0 {
-            return Err(ContactError::NegativeRadius {
+            return ContactError::NegativeRadius {
                 ball,
                 value: b.radius,
-            });
+            };
         }
     }
-    Ok(contact_time_unchecked(first, second))
+    unreachable!("first_invalid called on valid input")
 }
 
 /// A length or velocity difference held exactly as `hi + lo` (TwoSum output).
 type Pair = (f64, f64);
 
-/// A power of two that keeps `x − y` and `x + y` finite: `2⁻⁴` when some magnitude is
-/// near the top of the range, else 1. (Scaling down may drop subnormal bits of *other*
-/// inputs — 2²⁰⁰⁰ times smaller than the largest, see the contract.)
-fn prescale(max_abs: f64) -> i32 {
-    if max_abs >= pow2(1020) { -4 } else { 0 }
-}
-
 /// [`contact_time`] for inputs already known to be finite with non-negative radii.
+#[inline]
 pub fn contact_time_unchecked<const D: usize>(first: &Ball<D>, second: &Ball<D>) -> Contact {
-    let lmax = first
-        .position
-        .iter()
-        .chain(&second.position)
-        .fold(first.radius.max(second.radius), |m, x| m.max(x.abs()));
-    let vmax = first
-        .velocity
-        .iter()
-        .chain(&second.velocity)
-        .fold(0.0f64, |m, x| m.max(x.abs()));
-    let (lpre, vpre) = (prescale(lmax), prescale(vmax));
-    let len = |x: f64| if lpre == 0 { x } else { scale2(x, lpre) };
-    let vel = |x: f64| if vpre == 0 { x } else { scale2(x, vpre) };
-
-    let mut dr = [(0.0, 0.0); D];
-    let mut dv = [(0.0, 0.0); D];
-    for i in 0..D {
-        dr[i] = two_sum(len(second.position[i]), -len(first.position[i]));
-        dv[i] = two_sum(vel(second.velocity[i]), -vel(first.velocity[i]));
+    let (dr, dv, sigma) = differences(first, second, 0, 0);
+    // TwoSum is exact unless something near the top of the range overflows; then redo the
+    // differences with lengths and/or velocities scaled by 2⁻⁴ (which can only drop subnormal
+    // bits of inputs 2²⁰⁰⁰ times smaller than the largest — see the contract).
+    let (lmax, vmax) = (max_length(&dr, sigma), max_velocity(&dv));
+    let safe = |m: f64| m < pow2(1020);
+    if safe(lmax) && safe(vmax) {
+        return contact_of_differences(&dr, &dv, sigma, 0, true);
     }
-    let sigma = two_sum(len(first.radius), len(second.radius));
+    let (lpre, vpre) = (
+        if safe(lmax) { 0 } else { -4 },
+        if safe(vmax) { 0 } else { -4 },
+    );
+    let (dr, dv, sigma) = differences(first, second, lpre, vpre);
     contact_of_differences(&dr, &dv, sigma, vpre - lpre, true)
 }
 
@@ -230,35 +233,60 @@ pub fn contact_time_unchecked<const D: usize>(first: &Ball<D>, second: &Ball<D>)
 /// paths against the oracle, and for the benchmarks. Inputs as for [`contact_time_unchecked`].
 #[doc(hidden)]
 pub fn contact_time_exact_path<const D: usize>(first: &Ball<D>, second: &Ball<D>) -> Contact {
+    let (dr, dv, sigma) = differences(first, second, 0, 0);
+    let safe = |m: f64| m < pow2(1020);
+    let (lpre, vpre) = (
+        if safe(max_length(&dr, sigma)) { 0 } else { -4 },
+        if safe(max_velocity(&dv)) { 0 } else { -4 },
+    );
+    let (dr, dv, sigma) = differences(first, second, lpre, vpre);
+    contact_of_differences(&dr, &dv, sigma, vpre - lpre, false)
+}
+
+/// `Δr`, `Δv`, `σ` as exact TwoSum pairs, lengths scaled by `2^lpre`, velocities by `2^vpre`.
+#[inline(always)]
+fn differences<const D: usize>(
+    first: &Ball<D>,
+    second: &Ball<D>,
+    lpre: i32,
+    vpre: i32,
+) -> ([Pair; D], [Pair; D], Pair) {
+    let len = |x: f64| if lpre == 0 { x } else { scale2(x, lpre) };
+    let vel = |x: f64| if vpre == 0 { x } else { scale2(x, vpre) };
     let mut dr = [(0.0, 0.0); D];
     let mut dv = [(0.0, 0.0); D];
-    let lmax = first
-        .position
-        .iter()
-        .chain(&second.position)
-        .fold(first.radius.max(second.radius), |m, x| m.max(x.abs()));
-    let vmax = first
-        .velocity
-        .iter()
-        .chain(&second.velocity)
-        .fold(0.0f64, |m, x| m.max(x.abs()));
-    let (lpre, vpre) = (prescale(lmax), prescale(vmax));
     for i in 0..D {
-        dr[i] = two_sum(
-            scale2(second.position[i], lpre),
-            -scale2(first.position[i], lpre),
-        );
-        dv[i] = two_sum(
-            scale2(second.velocity[i], vpre),
-            -scale2(first.velocity[i], vpre),
-        );
+        dr[i] = two_sum(len(second.position[i]), -len(first.position[i]));
+        dv[i] = two_sum(vel(second.velocity[i]), -vel(first.velocity[i]));
     }
-    let sigma = two_sum(scale2(first.radius, lpre), scale2(second.radius, lpre));
-    contact_of_differences(&dr, &dv, sigma, vpre - lpre, false)
+    (dr, dv, two_sum(len(first.radius), len(second.radius)))
+}
+
+/// The largest |head| of Δr and σ; NaN or ∞ (which compare as "not < 2¹⁰²⁰") after overflow.
+#[inline(always)]
+fn max_length<const D: usize>(dr: &[Pair; D], sigma: Pair) -> f64 {
+    let mut m = sigma.0 + sigma.1 * 0.0;
+    for p in dr {
+        let a = p.0.abs() + p.1 * 0.0;
+        m = if a > m || a.is_nan() { a } else { m };
+    }
+    m
+}
+
+/// The largest |head| of Δv (NaN or ∞ after overflow).
+#[inline(always)]
+fn max_velocity<const D: usize>(dv: &[Pair; D]) -> f64 {
+    let mut m = 0.0;
+    for p in dv {
+        let a = p.0.abs() + p.1 * 0.0;
+        m = if a > m || a.is_nan() { a } else { m };
+    }
+    m
 }
 
 /// The contact given exact differences `Δr`, `Δv`, `σ` as (hi, lo) pairs; the resulting time
 /// is multiplied by `2^time_exp`.
+#[inline(always)]
 fn contact_of_differences<const D: usize>(
     dr: &[Pair; D],
     dv: &[Pair; D],
@@ -288,7 +316,18 @@ fn contact_of_differences<const D: usize>(
     let sp = |p: Pair, k: i32| (scale2(p.0, k), scale2(p.1, k));
     let dr = dr.map(|p| sp(p, -el));
     let dv = dv.map(|p| sp(p, -ev));
-    exact(&dr, &dv, sp(sigma, -el), time_exp + el - ev)
+    exact_cold(&dr, &dv, sp(sigma, -el), time_exp + el - ev)
+}
+
+#[cold]
+#[inline(never)]
+fn exact_cold<const D: usize>(
+    dr: &[Pair; D],
+    dv: &[Pair; D],
+    sigma: Pair,
+    time_exp: i32,
+) -> Contact {
+    exact(dr, dv, sigma, time_exp)
 }
 
 // ---------------------------------------------------------------------------------------
@@ -310,7 +349,7 @@ const DD_ACCEPT: f64 = 1.0 / (1u64 << 18) as f64;
 ///
 /// Notation: `Δrᵢ = hᵢ + lᵢ`, `Δvᵢ = gᵢ + mᵢ`, `σ = s + t`, with `|lᵢ| ≤ u|hᵢ|` (and alike),
 /// all of `|hᵢ|, s, |gᵢ|` in `2^±150` (checked by the caller), u = 2⁻⁵³.
-#[inline]
+#[inline(always)]
 fn filtered<const D: usize>(dr: &[Pair; D], dv: &[Pair; D], sigma: Pair) -> Option<Contact> {
     // --- b = ⟨Δv|Δr⟩ in f64. With P = Σ|hᵢgᵢ|: the FMA chain errs by ≤ D·u·P(1+Du) and
     // the dropped terms hᵢmᵢ + lᵢgᵢ + lᵢmᵢ by ≤ (2u + u²)P; (D + 3)·u·P covers both.
