@@ -162,14 +162,27 @@ pub fn contact_time<const D: usize>(
     first: &Ball<D>,
     second: &Ball<D>,
 ) -> Result<Contact, ContactError> {
-    // Branch-free screen: x·0 is ±0 for finite x and NaN otherwise.
-    let mut z = first.radius * 0.0 + second.radius * 0.0;
-    for i in 0..D {
-        z += first.position[i] * 0.0 + second.position[i] * 0.0;
-        z += first.velocity[i] * 0.0 + second.velocity[i] * 0.0;
+    match filtered(first, second) {
+        Some(contact) => Ok(contact),
+        None => validated_exact(first, second),
     }
-    if z == 0.0 && first.radius >= 0.0 && second.radius >= 0.0 {
-        Ok(contact_time_unchecked(first, second))
+}
+
+/// The cold path of [`contact_time`]: invalid inputs are reported here, valid ones go to
+/// the exact path.
+#[cold]
+#[inline(never)]
+fn validated_exact<const D: usize>(
+    first: &Ball<D>,
+    second: &Ball<D>,
+) -> Result<Contact, ContactError> {
+    let valid = [first, second].iter().all(|b| {
+        b.position.iter().chain(&b.velocity).all(|x| x.is_finite())
+            && b.radius.is_finite()
+            && b.radius >= 0.0
+    });
+    if valid {
+        Ok(exact_full(first, second))
     } else {
         Err(first_invalid(first, second))
     }
@@ -212,35 +225,33 @@ type Pair = (f64, f64);
 /// [`contact_time`] for inputs already known to be finite with non-negative radii.
 #[inline]
 pub fn contact_time_unchecked<const D: usize>(first: &Ball<D>, second: &Ball<D>) -> Contact {
-    let (dr, dv, sigma) = differences(first, second, 0, 0);
-    // TwoSum is exact unless something near the top of the range overflows; then redo the
-    // differences with lengths and/or velocities scaled by 2⁻⁴ (which can only drop subnormal
-    // bits of inputs 2²⁰⁰⁰ times smaller than the largest — see the contract).
-    let (lmax, vmax) = (max_length(&dr, sigma), max_velocity(&dv));
-    let safe = |m: f64| m < pow2(1020);
-    if safe(lmax) && safe(vmax) {
-        return contact_of_differences(&dr, &dv, sigma, 0, true);
-    }
-    let (lpre, vpre) = (
-        if safe(lmax) { 0 } else { -4 },
-        if safe(vmax) { 0 } else { -4 },
-    );
-    let (dr, dv, sigma) = differences(first, second, lpre, vpre);
-    contact_of_differences(&dr, &dv, sigma, vpre - lpre, true)
+    filtered(first, second).unwrap_or_else(|| exact_full(first, second))
 }
 
 /// The exact (expansion) path alone, bypassing the filter: for the tests that prove both
 /// paths against the oracle, and for the benchmarks. Inputs as for [`contact_time_unchecked`].
 #[doc(hidden)]
 pub fn contact_time_exact_path<const D: usize>(first: &Ball<D>, second: &Ball<D>) -> Contact {
+    exact_full(first, second)
+}
+
+/// The exact path from the inputs: exact differences (TwoSum), scaled, then expansions.
+fn exact_full<const D: usize>(first: &Ball<D>, second: &Ball<D>) -> Contact {
+    // TwoSum is exact unless something near the top of the range overflows; then the
+    // differences are redone with lengths and/or velocities scaled by 2⁻⁴ (which can only
+    // drop subnormal bits of inputs 2²⁰⁰⁰ times smaller than the largest — see the contract).
     let (dr, dv, sigma) = differences(first, second, 0, 0);
     let safe = |m: f64| m < pow2(1020);
     let (lpre, vpre) = (
         if safe(max_length(&dr, sigma)) { 0 } else { -4 },
         if safe(max_velocity(&dv)) { 0 } else { -4 },
     );
-    let (dr, dv, sigma) = differences(first, second, lpre, vpre);
-    contact_of_differences(&dr, &dv, sigma, vpre - lpre, false)
+    let (dr, dv, sigma) = if lpre == 0 && vpre == 0 {
+        (dr, dv, sigma)
+    } else {
+        differences(first, second, lpre, vpre)
+    };
+    contact_of_differences(&dr, &dv, sigma, vpre - lpre)
 }
 
 /// `Δr`, `Δv`, `σ` as exact TwoSum pairs, lengths scaled by `2^lpre`, velocities by `2^vpre`.
@@ -284,31 +295,23 @@ fn max_velocity<const D: usize>(dv: &[Pair; D]) -> f64 {
     m
 }
 
-/// The contact given exact differences `Δr`, `Δv`, `σ` as (hi, lo) pairs; the resulting time
-/// is multiplied by `2^time_exp`.
-#[inline(always)]
+/// The contact given exact differences `Δr`, `Δv`, `σ` as (hi, lo) pairs, by the exact
+/// path; the resulting time is multiplied by `2^time_exp`.
 fn contact_of_differences<const D: usize>(
     dr: &[Pair; D],
     dv: &[Pair; D],
     sigma: Pair,
     time_exp: i32,
-    use_filter: bool,
 ) -> Contact {
     // Δv = 0 exactly iff every TwoSum head is 0.
-    let vmax = dv.iter().fold(0.0f64, |m, p| m.max(p.0.abs()));
+    let vmax = max_velocity(dv);
     if vmax == 0.0 {
         return Contact::Never(Miss::NoRelativeMotion);
     }
-    let lmax = dr.iter().fold(sigma.0, |m, p| m.max(p.0.abs()));
+    let lmax = max_length(dr, sigma);
     if lmax == 0.0 {
         // Δr = 0 and σ = 0: b = 0, tangential.
         return Contact::Never(Miss::Receding);
-    }
-    let range = pow2(-150)..=pow2(150);
-    if use_filter && time_exp == 0 && range.contains(&lmax) && range.contains(&vmax) {
-        if let Some(contact) = filtered(dr, dv, sigma) {
-            return contact;
-        }
     }
     // Scale lengths and velocities separately to magnitude [1, 2): exact (but for the
     // underflow caveat in the contract), and the time scales by 2^(el − ev).
@@ -316,18 +319,7 @@ fn contact_of_differences<const D: usize>(
     let sp = |p: Pair, k: i32| (scale2(p.0, k), scale2(p.1, k));
     let dr = dr.map(|p| sp(p, -el));
     let dv = dv.map(|p| sp(p, -ev));
-    exact_cold(&dr, &dv, sp(sigma, -el), time_exp + el - ev)
-}
-
-#[cold]
-#[inline(never)]
-fn exact_cold<const D: usize>(
-    dr: &[Pair; D],
-    dv: &[Pair; D],
-    sigma: Pair,
-    time_exp: i32,
-) -> Contact {
-    exact(dr, dv, sigma, time_exp)
+    exact(&dr, &dv, sp(sigma, -el), time_exp + el - ev)
 }
 
 // ---------------------------------------------------------------------------------------
@@ -345,19 +337,43 @@ const SLACK: f64 = 1e-300;
 /// Its bound is ~2⁻⁹⁸ of the scale below, so values above 2⁻¹⁸ of the scale qualify.
 const DD_ACCEPT: f64 = 1.0 / (1u64 << 18) as f64;
 
-/// The certified answer, or `None` when the exact path must decide.
+/// The certified answer, or `None` when the exact path must decide (or the input is invalid:
+/// a NaN, an infinity or a negative radius fails the range screen and goes to the cold path).
 ///
-/// Notation: `Δrᵢ = hᵢ + lᵢ`, `Δvᵢ = gᵢ + mᵢ`, `σ = s + t`, with `|lᵢ| ≤ u|hᵢ|` (and alike),
-/// all of `|hᵢ|, s, |gᵢ|` in `2^±150` (checked by the caller), u = 2⁻⁵³.
+/// Notation: `Δrᵢ = hᵢ + lᵢ`, `Δvᵢ = gᵢ + mᵢ`, `σ = s + t`, where the heads are the rounded
+/// differences (sum) and the tails their rounding errors, `|lᵢ| ≤ u|hᵢ|` (and alike),
+/// u = 2⁻⁵³. The sign tests use the heads alone, with bounds that allow for the tails; the
+/// tails are computed (TwoSum) only when a contact time must be evaluated. All of `|hᵢ|`,
+/// `s`, `|gᵢ|` must lie in `2^±150` (largest of each kind at least 2⁻¹⁵⁰), which keeps
+/// every product in range.
 #[inline(always)]
-fn filtered<const D: usize>(dr: &[Pair; D], dv: &[Pair; D], sigma: Pair) -> Option<Contact> {
+fn filtered<const D: usize>(first: &Ball<D>, second: &Ball<D>) -> Option<Contact> {
+    const HI: f64 = pow2(150);
+    const LO: f64 = pow2(-150);
+    let mut h = [0.0; D];
+    let mut g = [0.0; D];
+    let s = first.radius + second.radius;
+    // Comparisons with NaN are false, so one flag screens NaN, ±∞ and negative radii too.
+    let mut ok = first.radius >= 0.0 && second.radius >= 0.0 && s <= HI;
+    let (mut lmax, mut vmax) = (s, 0.0f64);
+    for i in 0..D {
+        h[i] = second.position[i] - first.position[i];
+        g[i] = second.velocity[i] - first.velocity[i];
+        let (ah, ag) = (h[i].abs(), g[i].abs());
+        ok &= ah <= HI && ag <= HI;
+        lmax = lmax.max(ah);
+        vmax = vmax.max(ag);
+    }
+    if !(ok && lmax >= LO && vmax >= LO) {
+        return None;
+    }
     // --- b = ⟨Δv|Δr⟩ in f64. With P = Σ|hᵢgᵢ|: the FMA chain errs by ≤ D·u·P(1+Du) and
-    // the dropped terms hᵢmᵢ + lᵢgᵢ + lᵢmᵢ by ≤ (2u + u²)P; (D + 3)·u·P covers both.
+    // the dropped terms hᵢmᵢ + lᵢgᵢ + lᵢmᵢ by ≤ (2u + u²)P; (D + 4)·u·P covers both.
     let mut b = 0.0;
     let mut p = 0.0;
     for i in 0..D {
-        b = dr[i].0.mul_add(dv[i].0, b);
-        p += (dr[i].0 * dv[i].0).abs();
+        b = h[i].mul_add(g[i], b);
+        p += (h[i] * g[i]).abs();
     }
     let bound_b = (D as f64 + 4.0) * U * p + SLACK;
     if b > bound_b {
@@ -368,12 +384,11 @@ fn filtered<const D: usize>(dr: &[Pair; D], dv: &[Pair; D], sigma: Pair) -> Opti
     }
     // --- c = |Δr|² − σ². With Q = Σhᵢ² + s²: chain error ≤ (D + 1)·u·Q, dropped
     // 2hᵢlᵢ + lᵢ² − 2st − t² ≤ (2u + u²)·Q.
-    let (s, st) = sigma;
     let mut c = -(s * s);
     let mut q = s * s;
-    for h in dr.iter().map(|p| p.0) {
-        c = h.mul_add(h, c);
-        q = h.mul_add(h, q);
+    for &x in &h {
+        c = x.mul_add(x, c);
+        q = x.mul_add(x, q);
     }
     let bound_c = (D as f64 + 5.0) * U * q + SLACK;
     if c < -bound_c {
@@ -386,15 +401,15 @@ fn filtered<const D: usize>(dr: &[Pair; D], dv: &[Pair; D], sigma: Pair) -> Opti
     // A = a·s² + ΣXᵢⱼ²: each factor errs by a few u relative to its own scale (a by
     // (D + 3)u, s² by 3u, each cross term by 4u·Xᵢⱼ), so 32·u·A bounds the total for D ≤ 3.
     let mut a = 0.0;
-    for g in dv.iter().map(|p| p.0) {
-        a = g.mul_add(g, a);
+    for &x in &g {
+        a = x.mul_add(x, a);
     }
     let asig = a * (s * s);
     let mut disc = asig;
     let mut scale = asig;
     for i in 0..D {
         for j in i + 1..D {
-            let (hi, hj, gi, gj) = (dr[i].0, dr[j].0, dv[i].0, dv[j].0);
+            let (hi, hj, gi, gj) = (h[i], h[j], g[i], g[j]);
             let cross = hi.mul_add(gj, -(hj * gi));
             let x = (hi * gj).abs() + (hj * gi).abs();
             disc = (-cross).mul_add(cross, disc);
@@ -416,6 +431,10 @@ fn filtered<const D: usize>(dr: &[Pair; D], dv: &[Pair; D], sigma: Pair) -> Opti
     if -b < DD_ACCEPT * p || c < DD_ACCEPT * q || disc < DD_ACCEPT * scale {
         return None;
     }
+    // The tails, now that they are needed: TwoSum heads equal the rounded differences above.
+    let (dr, dv, sigma) = differences(first, second, 0, 0);
+    let (dr, dv) = (&dr, &dv);
+    let st = sigma.1;
     let neg_b = {
         let mut acc = Acc::default();
         for i in 0..D {

@@ -186,6 +186,87 @@ impl Dd {
     }
 }
 
+/// Adds `b` to the expansion `e[..len]` in place (Shewchuk's GROW-EXPANSION with zero
+/// elimination); `e` needs room for `len + 1` components. Returns the new length.
+#[inline]
+pub fn grow_in_place(e: &mut [f64], len: usize, b: f64) -> usize {
+    let mut q = b;
+    let mut out = 0;
+    for i in 0..len {
+        let (s, h) = two_sum(q, e[i]);
+        if h != 0.0 {
+            e[out] = h; // out ≤ i: never overwrites a component still to be read
+            out += 1;
+        }
+        q = s;
+    }
+    if q != 0.0 {
+        e[out] = q;
+        out += 1;
+    }
+    out
+}
+
+/// Compresses the expansion `e[..len]` in place (Shewchuk's COMPRESS, which allows its
+/// input and output to coincide); afterwards the components are non-adjacent, so the
+/// largest approximates the value within one ulp. Returns the new length.
+pub fn compress_in_place(e: &mut [f64], len: usize) -> usize {
+    if len < 2 {
+        return len;
+    }
+    let mut bottom = len - 1;
+    let mut q = e[len - 1];
+    for i in (0..len - 1).rev() {
+        let (s, t) = fast_two_sum(q, e[i]);
+        if t != 0.0 {
+            e[bottom] = s;
+            bottom -= 1;
+            q = t;
+        } else {
+            q = s;
+        }
+    }
+    e[bottom] = q;
+    let mut top = 0;
+    for i in bottom + 1..len {
+        let (s, t) = fast_two_sum(e[i], q);
+        if t != 0.0 {
+            e[top] = t;
+            top += 1;
+        }
+        q = s;
+    }
+    if q != 0.0 {
+        e[top] = q;
+        top += 1;
+    }
+    top
+}
+
+/// The value of a compressed expansion as a double-double (~2⁻¹⁰⁴ relative): summing a
+/// geometrically decreasing expansion from the bottom keeps the error below the tail.
+#[inline]
+pub fn dd_of_compressed(e: &[f64]) -> Dd {
+    let mut hi = 0.0;
+    let mut lo = 0.0;
+    for &x in e {
+        let (s, t) = two_sum(hi, x);
+        hi = s;
+        lo += t;
+    }
+    Dd::new(hi, lo)
+}
+
+/// The exact sign of an expansion (that of its largest, i.e. last, component).
+#[inline]
+pub fn sign_of(e: &[f64]) -> Ordering {
+    match e.last() {
+        None => Ordering::Equal,
+        Some(&x) if x > 0.0 => Ordering::Greater,
+        Some(_) => Ordering::Less,
+    }
+}
+
 /// An exact real number held as a sum of non-overlapping f64 components, in increasing
 /// order of magnitude, with no zero components (Shewchuk 1997). The empty expansion is 0.
 ///
@@ -227,19 +308,12 @@ impl Expansion {
 
     /// `self + b`, exactly (Shewchuk's GROW-EXPANSION with zero elimination).
     pub fn add_f64(&self, b: f64) -> Expansion {
-        let mut out = Vec::with_capacity(self.c.len() + 1);
-        let mut q = b;
-        for &e in &self.c {
-            let (s, h) = two_sum(q, e);
-            if h != 0.0 {
-                out.push(h);
-            }
-            q = s;
-        }
-        if q != 0.0 {
-            out.push(q);
-        }
-        Expansion { c: out }
+        let mut c = Vec::with_capacity(self.c.len() + 1);
+        c.extend_from_slice(&self.c);
+        c.push(0.0);
+        let len = grow_in_place(&mut c, self.c.len(), b);
+        c.truncate(len);
+        Expansion { c }
     }
 
     /// `self + other`, exactly.
@@ -322,45 +396,15 @@ impl Expansion {
     /// The same value with fewer, non-adjacent components (Shewchuk's COMPRESS); afterwards
     /// the largest component approximates the value to within one ulp.
     pub fn compress(&self) -> Expansion {
-        let m = self.c.len();
-        if m < 2 {
-            return self.clone();
-        }
-        let mut g = vec![0.0; m];
-        let mut bottom = m - 1;
-        let mut q = self.c[m - 1];
-        for i in (0..m - 1).rev() {
-            let (s, e) = fast_two_sum(q, self.c[i]);
-            if e != 0.0 {
-                g[bottom] = s;
-                bottom -= 1;
-                q = e;
-            } else {
-                q = s;
-            }
-        }
-        g[bottom] = q;
-        let mut out = Vec::with_capacity(m - bottom);
-        for &gi in &g[bottom + 1..m] {
-            let (s, e) = fast_two_sum(gi, q);
-            if e != 0.0 {
-                out.push(e);
-            }
-            q = s;
-        }
-        if q != 0.0 {
-            out.push(q);
-        }
-        Expansion { c: out }
+        let mut c = self.c.clone();
+        let len = compress_in_place(&mut c, self.c.len());
+        c.truncate(len);
+        Expansion { c }
     }
 
     /// The exact sign: that of the largest component.
     pub fn sign(&self) -> Ordering {
-        match self.c.last() {
-            None => Ordering::Equal,
-            Some(&x) if x > 0.0 => Ordering::Greater,
-            Some(_) => Ordering::Less,
-        }
+        sign_of(&self.c)
     }
 
     /// The largest component's magnitude (0 for 0): within a factor 2 of `|value|` after
@@ -371,17 +415,7 @@ impl Expansion {
 
     /// The value rounded to a double-double, ~2⁻¹⁰⁴ relative.
     pub fn to_dd(&self) -> Dd {
-        let c = self.compress();
-        // Summing a compressed (geometrically decreasing) expansion from the bottom keeps
-        // the accumulated error far below the trailing part.
-        let mut hi = 0.0;
-        let mut lo = 0.0;
-        for &x in &c.c {
-            let (s, e) = two_sum(hi, x);
-            hi = s;
-            lo += e;
-        }
-        Dd::new(hi, lo)
+        dd_of_compressed(&self.compress().c)
     }
 }
 

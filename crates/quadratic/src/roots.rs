@@ -41,7 +41,9 @@
 //!
 //! The tests in `crates/quadratic/tests/` prove this against an exact big-integer oracle.
 
-use crate::exact::{Dd, Expansion, exponent, scale2, two_prod};
+use crate::exact::{
+    Dd, compress_in_place, dd_of_compressed, exponent, grow_in_place, scale2, sign_of, two_prod,
+};
 use core::cmp::Ordering;
 use core::fmt;
 
@@ -186,15 +188,21 @@ fn solve_finite(a: f64, b: f64, c: f64) -> Roots {
     let b1 = scale2(b, -eb);
     let c1 = scale2(c, m); // exponent of c' is K ∈ [−220, 220]: exact
 
-    // Δ' = b'² − 4a'c', exactly, as an expansion of four components.
+    // Δ' = b'² − 4a'c', exactly, as an expansion of at most four components (on the stack).
     let (p, pe) = two_prod(b1, b1);
     let (q, qe) = two_prod(4.0 * a1, c1);
-    let disc = Expansion::from_pair(p, pe).sub(&Expansion::from_pair(q, qe));
-    match disc.sign() {
+    let mut disc = [0.0; 4];
+    let mut len = 0;
+    for term in [pe, -qe, p, -q] {
+        len = grow_in_place(&mut disc, len, term);
+    }
+    let len = compress_in_place(&mut disc, len);
+    let disc = &disc[..len];
+    match sign_of(disc) {
         Ordering::Less => Roots::None,
         Ordering::Equal => Roots::One(plus_zero(scale2(-b1 / (2.0 * a1), s))),
         Ordering::Greater => {
-            let root = disc.to_dd().sqrt();
+            let root = dd_of_compressed(disc).sqrt();
             let signed = if b1 > 0.0 { root } else { root.neg() };
             // q = −(b' + sign(b')√Δ')/2: the two terms have the same sign, no cancellation.
             let q = Dd::from_f64(b1).add(signed);
