@@ -75,6 +75,10 @@ pub fn scale2(x: f64, k: i32) -> f64 {
     }
     let ex = exponent(x);
     let target = ex.saturating_add(k);
+    if (-1022..=1023).contains(&k) && (-1022..=1023).contains(&target) && ex >= -1022 {
+        // Normal in, normal out, 2^k representable: one exact multiplication.
+        return x * pow2(k);
+    }
     if target > 1023 {
         return f64::INFINITY.copysign(x);
     }

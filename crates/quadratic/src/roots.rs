@@ -42,7 +42,8 @@
 //! The tests in `crates/quadratic/tests/` prove this against an exact big-integer oracle.
 
 use crate::exact::{
-    Dd, compress_in_place, dd_of_compressed, exponent, grow_in_place, scale2, sign_of, two_prod,
+    Dd, compress_in_place, dd_of_compressed, exponent, grow_in_place, pow2, scale2, sign_of,
+    two_prod, two_sum,
 };
 use core::cmp::Ordering;
 use core::fmt;
@@ -188,21 +189,36 @@ fn solve_finite(a: f64, b: f64, c: f64) -> Roots {
     let b1 = scale2(b, -eb);
     let c1 = scale2(c, m); // exponent of c' is K ∈ [−220, 220]: exact
 
-    // Δ' = b'² − 4a'c', exactly, as an expansion of at most four components (on the stack).
+    // Δ' = b'² − 4a'c' = (p + pe) − (q + qe) exactly, with p = fl(b'²), q = fl(4a'c').
     let (p, pe) = two_prod(b1, b1);
     let (q, qe) = two_prod(4.0 * a1, c1);
-    let mut disc = [0.0; 4];
-    let mut len = 0;
-    for term in [pe, -qe, p, -q] {
-        len = grow_in_place(&mut disc, len, term);
-    }
-    let len = compress_in_place(&mut disc, len);
-    let disc = &disc[..len];
-    match sign_of(disc) {
+    let (d, de) = two_sum(p, -q);
+    // Fast path: when |p − q| is far above the tails (|pe|, |qe| ≤ u·(p + |q|)), the sign is
+    // that of d (the tail is below |d|/2) and (d, de + pe − qe) is the value to ~2⁻⁸⁵ relative. Otherwise (near-double
+    // roots) the four terms are summed exactly as an expansion on the stack.
+    let mut terms = [0.0; 4];
+    let (sign, value) = if d.abs() >= pow2(-20) * (p + q.abs()) {
+        (
+            if d > 0.0 {
+                Ordering::Greater
+            } else {
+                Ordering::Less
+            },
+            Dd::new(d, de + (pe - qe)),
+        )
+    } else {
+        let mut len = 0;
+        for term in [pe, -qe, de, d] {
+            len = grow_in_place(&mut terms, len, term);
+        }
+        let len = compress_in_place(&mut terms, len);
+        (sign_of(&terms[..len]), dd_of_compressed(&terms[..len]))
+    };
+    match sign {
         Ordering::Less => Roots::None,
         Ordering::Equal => Roots::One(plus_zero(scale2(-b1 / (2.0 * a1), s))),
         Ordering::Greater => {
-            let root = dd_of_compressed(disc).sqrt();
+            let root = value.sqrt();
             let signed = if b1 > 0.0 { root } else { root.neg() };
             // q = −(b' + sign(b')√Δ')/2: the two terms have the same sign, no cancellation.
             let q = Dd::from_f64(b1).add(signed);
