@@ -32,19 +32,9 @@ fn dense_fluid_pairs(eta: f64, side: usize, seed: u64) -> Vec<Pair> {
         for col in 0..side {
             let x = (col as f64 + 0.5 * (row % 2) as f64) * a + 10.0;
             let y = row as f64 * a * 3f64.sqrt() / 2.0 + 10.0;
-            let (dx, dy): (f64, f64) = (
-                rng.random_range(-jitter..jitter),
-                rng.random_range(-jitter..jitter),
-            );
-            let v = [
-                StandardNormal.sample(&mut rng),
-                StandardNormal.sample(&mut rng),
-            ];
-            disks.push(Ball {
-                position: [x + dx * 0.7, y + dy * 0.7],
-                velocity: v,
-                radius: 0.5,
-            });
+            let (dx, dy): (f64, f64) = (rng.random_range(-jitter..jitter), rng.random_range(-jitter..jitter));
+            let v = [StandardNormal.sample(&mut rng), StandardNormal.sample(&mut rng)];
+            disks.push(Ball { position: [x + dx * 0.7, y + dy * 0.7], velocity: v, radius: 0.5 });
         }
     }
     let mut pairs = Vec::new();
@@ -61,11 +51,7 @@ fn dense_fluid_pairs(eta: f64, side: usize, seed: u64) -> Vec<Pair> {
 
 fn hard_pairs(n: usize, seed: u64) -> Vec<Pair> {
     let mut rng = Xoshiro256PlusPlus::seed_from_u64(seed);
-    let ball = |position, velocity| Ball {
-        position,
-        velocity,
-        radius: 0.5,
-    };
+    let ball = |position, velocity| Ball { position, velocity, radius: 0.5 };
     (0..n)
         .map(|i| {
             let th: f64 = rng.random_range(0.0..std::f64::consts::TAU);
@@ -73,25 +59,15 @@ fn hard_pairs(n: usize, seed: u64) -> Vec<Pair> {
             let nudge = |x: f64| f64::from_bits((x.to_bits() as i64 + k) as u64);
             match i % 3 {
                 // Gap or overlap of a few ulps, approaching at a random angle.
-                0 => (
-                    ball([0.0, 0.0], [0.0, 0.0]),
-                    ball(
-                        [nudge(th.cos()), th.sin()],
-                        [-th.sin().abs() - 0.1, th.cos()],
-                    ),
-                ),
+                0 => {
+                    (ball([0.0, 0.0], [0.0, 0.0]), ball([nudge(th.cos()), th.sin()], [-th.sin().abs() - 0.1, th.cos()]))
+                }
                 // Grazing at 10⁶ diameters, impact parameter σ ± a few ulps.
-                1 => (
-                    ball([0.0, 0.0], [0.0, 0.0]),
-                    ball([1e6, nudge(1.0)], [-1.0, 0.0]),
-                ),
+                1 => (ball([0.0, 0.0], [0.0, 0.0]), ball([1e6, nudge(1.0)], [-1.0, 0.0])),
                 // Neighbours at 10⁹.
                 _ => {
                     let base = [1e9 * th.cos(), 1e9 * th.sin()];
-                    (
-                        ball(base, [0.0, 0.0]),
-                        ball([base[0] + 1.5, base[1] + 0.3], [-1.0, 0.1]),
-                    )
+                    (ball(base, [0.0, 0.0]), ball([base[0] + 1.5, base[1] + 0.3], [-1.0, 0.1]))
                 }
             }
         })
@@ -108,10 +84,7 @@ fn contact(c: &mut Criterion) {
             b.iter(|| {
                 let mut n = 0.0;
                 for (p, q) in pairs.iter() {
-                    n += contact_time(black_box(p), black_box(q))
-                        .unwrap()
-                        .time()
-                        .unwrap_or(-1.0);
+                    n += contact_time(black_box(p), black_box(q)).unwrap().time().unwrap_or(-1.0);
                 }
                 n
             })
@@ -120,9 +93,7 @@ fn contact(c: &mut Criterion) {
             b.iter(|| {
                 let mut n = 0.0;
                 for (p, q) in pairs.iter() {
-                    n += textbook::contact_time(black_box(p), black_box(q))
-                        .time()
-                        .unwrap_or(-1.0);
+                    n += textbook::contact_time(black_box(p), black_box(q)).time().unwrap_or(-1.0);
                 }
                 n
             })
@@ -131,9 +102,7 @@ fn contact(c: &mut Criterion) {
             b.iter(|| {
                 let mut n = 0.0;
                 for (p, q) in pairs.iter() {
-                    n += contact_time_exact_path(black_box(p), black_box(q))
-                        .time()
-                        .unwrap_or(-1.0);
+                    n += contact_time_exact_path(black_box(p), black_box(q)).time().unwrap_or(-1.0);
                 }
                 n
             })
@@ -145,26 +114,16 @@ fn contact(c: &mut Criterion) {
 fn roots(c: &mut Criterion) {
     let mut rng = Xoshiro256PlusPlus::seed_from_u64(3);
     let realistic: Vec<(f64, f64, f64)> = (0..3000)
-        .map(|_| {
-            (
-                rng.random_range(0.1..10.0),
-                rng.random_range(-10.0..10.0),
-                rng.random_range(-10.0..10.0),
-            )
-        })
+        .map(|_| (rng.random_range(0.1..10.0), rng.random_range(-10.0..10.0), rng.random_range(-10.0..10.0)))
         .collect();
     let hard: Vec<(f64, f64, f64)> = (0..3000)
         .map(|i| {
             let a: f64 = rng.random_range(1.0..2.0);
             let b: f64 = rng.random_range(1.0..2.0);
             match i % 3 {
-                0 => (
-                    a,
-                    b,
-                    f64::from_bits((b * b / (4.0 * a)).to_bits() + (i % 5) as u64),
-                ), // near-double
-                1 => (a * 1e300, b * 1e300, -a * 1e300), // overflowing b²
-                _ => (a * 1e-300, b, a * 1e-300),        // b² ≫ |4ac|
+                0 => (a, b, f64::from_bits((b * b / (4.0 * a)).to_bits() + (i % 5) as u64)), // near-double
+                1 => (a * 1e300, b * 1e300, -a * 1e300),                                     // overflowing b²
+                _ => (a * 1e-300, b, a * 1e-300),                                            // b² ≫ |4ac|
             }
         })
         .collect();
@@ -172,20 +131,10 @@ fn roots(c: &mut Criterion) {
         let mut group = c.benchmark_group(name);
         group.throughput(Throughput::Elements(cases.len() as u64));
         group.bench_function("robust", |b| {
-            b.iter(|| {
-                cases
-                    .iter()
-                    .map(|&(a, b, c)| solve(black_box(a), b, c).unwrap().as_vec().len())
-                    .sum::<usize>()
-            })
+            b.iter(|| cases.iter().map(|&(a, b, c)| solve(black_box(a), b, c).unwrap().as_vec().len()).sum::<usize>())
         });
         group.bench_function("textbook", |b| {
-            b.iter(|| {
-                cases
-                    .iter()
-                    .map(|&(a, b, c)| textbook::solve(black_box(a), b, c).as_vec().len())
-                    .sum::<usize>()
-            })
+            b.iter(|| cases.iter().map(|&(a, b, c)| textbook::solve(black_box(a), b, c).as_vec().len()).sum::<usize>())
         });
         group.finish();
     }
@@ -193,10 +142,7 @@ fn roots(c: &mut Criterion) {
 
 fn config() -> Criterion {
     // Short, many-sample runs: the machine is shared and noisy, medians are what we report.
-    Criterion::default()
-        .warm_up_time(Duration::from_secs(1))
-        .measurement_time(Duration::from_secs(3))
-        .sample_size(40)
+    Criterion::default().warm_up_time(Duration::from_secs(1)).measurement_time(Duration::from_secs(3)).sample_size(40)
 }
 
 criterion_group! { name = benches; config = config(); targets = contact, roots }

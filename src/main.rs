@@ -4,17 +4,13 @@
 use anyhow::{Context, Result, bail};
 use clap::{Args, Parser, Subcommand};
 use collide::io::numbers::{NumberFormat, format_text, parse_text};
-use collide::io::query::{Query, answer_lines, contact_time_dyn};
+use collide::io::query::{DynBall, Query, answer_lines, contact_time_dyn};
 use collide::quadratic::Roots;
 use std::io::{self, BufWriter};
 use std::process::ExitCode;
 
 #[derive(Parser)]
-#[command(
-    name = "collide",
-    version,
-    about = "Event-driven hard-disk dynamics on verified collision numerics"
-)]
+#[command(name = "collide", version, about = "Event-driven hard-disk dynamics on verified collision numerics")]
 struct Cli {
     #[command(subcommand)]
     command: Option<Command>,
@@ -43,11 +39,7 @@ struct Output {
 
 impl Output {
     fn format(&self) -> NumberFormat {
-        if self.hex {
-            NumberFormat::Hex
-        } else {
-            NumberFormat::Shortest
-        }
+        if self.hex { NumberFormat::Hex } else { NumberFormat::Shortest }
     }
 }
 
@@ -107,16 +99,10 @@ fn check() -> Result<ExitCode> {
     let report = collide::quadratic::reference::check_all();
     print!("{}", report.text);
     if report.failures == 0 {
-        println!(
-            "all {} reference cases agree with the exact answers",
-            report.cases
-        );
+        println!("all {} reference cases agree with the exact answers", report.cases);
         Ok(ExitCode::SUCCESS)
     } else {
-        eprintln!(
-            "collide: {} of {} reference cases disagree with the exact answers",
-            report.failures, report.cases
-        );
+        eprintln!("collide: {} of {} reference cases disagree with the exact answers", report.failures, report.cases);
         Ok(ExitCode::FAILURE)
     }
 }
@@ -125,8 +111,8 @@ fn check() -> Result<ExitCode> {
 fn jsonl(query: Query, format: NumberFormat) -> Result<ExitCode> {
     let stdin = io::stdin().lock();
     let stdout = BufWriter::new(io::stdout().lock());
-    let failed = answer_lines(query, stdin, stdout, io::stderr().lock(), format)
-        .context("reading stdin or writing stdout")?;
+    let failed =
+        answer_lines(query, stdin, stdout, io::stderr().lock(), format).context("reading stdin or writing stdout")?;
     if failed > 0 {
         eprintln!("collide: {failed} line(s) could not be answered");
         return Ok(ExitCode::FAILURE);
@@ -153,12 +139,7 @@ fn roots(args: RootsArgs) -> Result<ExitCode> {
         match roots {
             Roots::None => "none".to_string(),
             Roots::All => "all".to_string(),
-            other => other
-                .as_vec()
-                .iter()
-                .map(|&x| format_text(x, format))
-                .collect::<Vec<_>>()
-                .join(" "),
+            other => other.as_vec().iter().map(|&x| format_text(x, format)).collect::<Vec<_>>().join(" "),
         }
     );
     Ok(ExitCode::SUCCESS)
@@ -166,14 +147,7 @@ fn roots(args: RootsArgs) -> Result<ExitCode> {
 
 fn contact(args: ContactArgs) -> Result<ExitCode> {
     let format = args.output.format();
-    let given = [
-        &args.r1,
-        &args.v1,
-        &args.radius1,
-        &args.r2,
-        &args.v2,
-        &args.radius2,
-    ];
+    let given = [&args.r1, &args.v1, &args.radius1, &args.r2, &args.v2, &args.radius2];
     if args.output.jsonl {
         if given.iter().any(|x| x.is_some()) {
             bail!("give either --jsonl or the options --r1 --v1 --R1 --r2 --v2 --R2, not both");
@@ -181,11 +155,9 @@ fn contact(args: ContactArgs) -> Result<ExitCode> {
         return jsonl(Query::ContactTime, format);
     }
     let need = |value: &Option<String>, name: &str| -> Result<String> {
-        value.clone().with_context(|| {
-            format!(
-                "missing --{name} (all of --r1 --v1 --R1 --r2 --v2 --R2 are needed, or --jsonl)"
-            )
-        })
+        value
+            .clone()
+            .with_context(|| format!("missing --{name} (all of --r1 --v1 --R1 --r2 --v2 --R2 are needed, or --jsonl)"))
     };
     let vector = |value: &Option<String>, name: &str| -> Result<Vec<f64>> {
         need(value, name)?
@@ -197,18 +169,17 @@ fn contact(args: ContactArgs) -> Result<ExitCode> {
     let scalar = |value: &Option<String>, name: &str| -> Result<f64> {
         parse_text(&need(value, name)?).with_context(|| format!("--{name}"))
     };
-    let t = contact_time_dyn(
-        &vector(&args.r1, "r1")?,
-        &vector(&args.v1, "v1")?,
-        scalar(&args.radius1, "R1")?,
-        &vector(&args.r2, "r2")?,
-        &vector(&args.v2, "v2")?,
-        scalar(&args.radius2, "R2")?,
-    )
-    .map_err(anyhow::Error::msg)?;
-    println!(
-        "{}",
-        t.map_or_else(|| "never".to_string(), |t| format_text(t, format))
-    );
+    let first = DynBall {
+        position: vector(&args.r1, "r1")?,
+        velocity: vector(&args.v1, "v1")?,
+        radius: scalar(&args.radius1, "R1")?,
+    };
+    let second = DynBall {
+        position: vector(&args.r2, "r2")?,
+        velocity: vector(&args.v2, "v2")?,
+        radius: scalar(&args.radius2, "R2")?,
+    };
+    let t = contact_time_dyn(&first, &second).map_err(anyhow::Error::msg)?;
+    println!("{}", t.map_or_else(|| "never".to_string(), |t| format_text(t, format)));
     Ok(ExitCode::SUCCESS)
 }

@@ -11,12 +11,7 @@ fn collide(args: &[&str], stdin: &str) -> Output {
         .stderr(Stdio::piped())
         .spawn()
         .expect("the binary runs");
-    child
-        .stdin
-        .take()
-        .unwrap()
-        .write_all(stdin.as_bytes())
-        .unwrap();
+    child.stdin.take().unwrap().write_all(stdin.as_bytes()).unwrap();
     child.wait_with_output().unwrap()
 }
 
@@ -31,14 +26,8 @@ fn roots_prints_exact_roots_in_decimal_or_hex() {
     assert_eq!(text(&out.stdout), "1e-8 99999999.99999999\n");
     let out = collide(&["roots", "--hex", "0x1p0", "-0x1.8p+1", "2"], "");
     assert_eq!(text(&out.stdout), "0x1p+0 0x1p+1\n");
-    assert_eq!(
-        text(&collide(&["roots", "1", "0", "1"], "").stdout),
-        "none\n"
-    );
-    assert_eq!(
-        text(&collide(&["roots", "0", "-0", "0"], "").stdout),
-        "all\n"
-    );
+    assert_eq!(text(&collide(&["roots", "1", "0", "1"], "").stdout), "none\n");
+    assert_eq!(text(&collide(&["roots", "0", "-0", "0"], "").stdout), "all\n");
 }
 
 #[test]
@@ -46,98 +35,33 @@ fn roots_rejects_bad_numbers_with_a_clear_message() {
     let out = collide(&["roots", "1", "nan", "2"], "");
     assert_eq!(out.status.code(), Some(2));
     let err = text(&out.stderr);
-    assert!(
-        err.contains("coefficient B") && err.contains("'nan' is not a finite f64"),
-        "{err}"
-    );
-    assert!(
-        !err.contains("panicked") && !err.contains("backtrace"),
-        "{err}"
-    );
+    assert!(err.contains("coefficient B") && err.contains("'nan' is not a finite f64"), "{err}");
+    assert!(!err.contains("panicked") && !err.contains("backtrace"), "{err}");
     let out = collide(&["roots", "1", "2"], "");
-    assert_eq!(
-        out.status.code(),
-        Some(2),
-        "two coefficients is a usage error"
-    );
+    assert_eq!(out.status.code(), Some(2), "two coefficients is a usage error");
 }
 
 #[test]
 fn contact_time_prints_time_or_never() {
-    let args = [
-        "contact-time",
-        "--r1",
-        "0,0",
-        "--v1",
-        "1,0",
-        "--R1",
-        "0.5",
-        "--r2",
-        "3,0",
-        "--v2",
-        "-1,0",
-        "--R2",
-        "0.5",
-    ];
+    let args =
+        ["contact-time", "--r1", "0,0", "--v1", "1,0", "--R1", "0.5", "--r2", "3,0", "--v2", "-1,0", "--R2", "0.5"];
     let out = collide(&args, "");
     assert!(out.status.success(), "{}", text(&out.stderr));
     assert_eq!(text(&out.stdout), "1.0\n");
-    let never = [
-        "contact-time",
-        "--r1",
-        "0,0",
-        "--v1",
-        "0,0",
-        "--R1",
-        "0.5",
-        "--r2",
-        "3,0",
-        "--v2",
-        "1,0",
-        "--R2",
-        "0.5",
-    ];
+    let never =
+        ["contact-time", "--r1", "0,0", "--v1", "0,0", "--R1", "0.5", "--r2", "3,0", "--v2", "1,0", "--R2", "0.5"];
     assert_eq!(text(&collide(&never, "").stdout), "never\n");
-    let spheres = [
-        "contact-time",
-        "--r1=0,0,0",
-        "--v1=0,0,0",
-        "--R1=1",
-        "--r2=0,0,4",
-        "--v2=0,0,-1",
-        "--R2=1",
-        "--hex",
-    ];
+    let spheres =
+        ["contact-time", "--r1=0,0,0", "--v1=0,0,0", "--R1=1", "--r2=0,0,4", "--v2=0,0,-1", "--R2=1", "--hex"];
     assert_eq!(text(&collide(&spheres, "").stdout), "0x1p+1\n");
-    let bad = [
-        "contact-time",
-        "--r1",
-        "0,0",
-        "--v1",
-        "1,0",
-        "--R1",
-        "-0.5",
-        "--r2",
-        "3,0",
-        "--v2",
-        "-1,0",
-        "--R2",
-        "0.5",
-    ];
+    let bad =
+        ["contact-time", "--r1", "0,0", "--v1", "1,0", "--R1", "-0.5", "--r2", "3,0", "--v2", "-1,0", "--R2", "0.5"];
     let out = collide(&bad, "");
     assert_eq!(out.status.code(), Some(2));
-    assert!(
-        text(&out.stderr).contains("R1 = -0.5 is negative"),
-        "{}",
-        text(&out.stderr)
-    );
+    assert!(text(&out.stderr).contains("R1 = -0.5 is negative"), "{}", text(&out.stderr));
     let missing = collide(&["contact-time", "--r1", "0,0"], "");
     assert_eq!(missing.status.code(), Some(2));
-    assert!(
-        text(&missing.stderr).contains("missing --v1"),
-        "{}",
-        text(&missing.stderr)
-    );
+    assert!(text(&missing.stderr).contains("missing --v1"), "{}", text(&missing.stderr));
 }
 
 #[test]
@@ -145,15 +69,13 @@ fn jsonl_answers_every_good_line_and_fails_at_the_end_for_bad_ones() {
     let input = "{\"id\": \"a\", \"a\": 1, \"b\": -3, \"c\": 2}\n{\"id\": 2, \"a\": 1\n{\"id\": 3, \"a\": \"0x1p-1074\", \"b\": 0, \"c\": \"-0x1p-1074\"}\n";
     let out = collide(&["roots", "--jsonl"], input);
     assert_eq!(out.status.code(), Some(1));
-    assert_eq!(
-        text(&out.stdout),
-        "{\"id\":\"a\",\"roots\":[1.0,2.0]}\n{\"id\":3,\"roots\":[-1.0,1.0]}\n"
-    );
+    assert_eq!(text(&out.stdout), "{\"id\":\"a\",\"roots\":[1.0,2.0]}\n{\"id\":3,\"roots\":[-1.0,1.0]}\n");
     let err = text(&out.stderr);
     assert!(err.starts_with("line 2: not valid JSON"), "{err}");
     assert!(err.contains("1 line(s) could not be answered"), "{err}");
 
-    let input = "{\"id\": 7, \"r1\": [0, 0], \"v1\": [1, 0], \"R1\": 0.5, \"r2\": [3, 0], \"v2\": [-1, 0], \"R2\": 0.5}\n";
+    let input =
+        "{\"id\": 7, \"r1\": [0, 0], \"v1\": [1, 0], \"R1\": 0.5, \"r2\": [3, 0], \"v2\": [-1, 0], \"R2\": 0.5}\n";
     let out = collide(&["contact-time", "--jsonl", "--hex"], input);
     assert!(out.status.success());
     assert_eq!(text(&out.stdout), "{\"id\":7,\"t\":\"0x1p+0\"}\n");

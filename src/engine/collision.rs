@@ -52,11 +52,7 @@ impl Restitution {
 
     /// `e`, validated to lie in `[0, 1]`.
     pub fn new(e: f64) -> Result<Self, RestitutionError> {
-        if (0.0..=1.0).contains(&e) {
-            Ok(Restitution(e))
-        } else {
-            Err(RestitutionError(e))
-        }
+        if (0.0..=1.0).contains(&e) { Ok(Restitution(e)) } else { Err(RestitutionError(e)) }
     }
 
     /// The value of `e`.
@@ -102,29 +98,19 @@ impl<const D: usize> Impulse<D> {
 /// assert_eq!((a.velocity, b.velocity), (vector![-2.0, 0.0], vector![1.0, 0.0]));
 /// assert_eq!(j.virial(), 3.0); // σ·|Δp| = 1 · 3
 /// ```
-pub fn resolve_pair<const D: usize>(
-    first: &mut Body<D>,
-    second: &mut Body<D>,
-    e: Restitution,
-) -> Impulse<D> {
+pub fn resolve_pair<const D: usize>(first: &mut Body<D>, second: &mut Body<D>, e: Restitution) -> Impulse<D> {
     let normal = second.position - first.position;
     let approach = (first.velocity - second.velocity).dot(&normal);
     let n2 = normal.norm_squared();
     if approach <= 0.0 || n2 == 0.0 {
-        return Impulse {
-            on_second: SVector::zeros(),
-            normal,
-        };
+        return Impulse { on_second: SVector::zeros(), normal };
     }
     let (m1, m2) = (first.mass, second.mass);
     let mu = m1 * m2 / (m1 + m2);
     let j = normal * ((1.0 + e.0) * mu * approach / n2);
     first.velocity -= j / m1;
     second.velocity += j / m2;
-    Impulse {
-        on_second: j,
-        normal,
-    }
+    Impulse { on_second: j, normal }
 }
 
 #[cfg(test)]
@@ -137,11 +123,7 @@ mod tests {
     const EPS: f64 = f64::EPSILON;
 
     fn body2(p: [f64; 2], v: [f64; 2], m: f64) -> Body<2> {
-        Body {
-            position: Vector2::from(p),
-            velocity: Vector2::from(v),
-            mass: m,
-        }
+        Body { position: Vector2::from(p), velocity: Vector2::from(v), mass: m }
     }
 
     #[test]
@@ -197,37 +179,17 @@ mod tests {
     /// The energy error is ≤ a few u of Σ m|v|² + |J|²/μ; 16ε of that scale covers it.
     #[test]
     fn momentum_and_energy_are_conserved_to_rounding() {
-        let config = Config {
-            cases: 20_000,
-            failure_persistence: None,
-            ..Config::default()
-        };
-        let mut runner =
-            TestRunner::new_with_rng(config, TestRng::deterministic_rng(RngAlgorithm::ChaCha));
+        let config = Config { cases: 20_000, failure_persistence: None, ..Config::default() };
+        let mut runner = TestRunner::new_with_rng(config, TestRng::deterministic_rng(RngAlgorithm::ChaCha));
         let vec3 = || proptest::array::uniform3(-10.0..10.0f64);
-        let strategy = (
-            vec3(),
-            vec3(),
-            vec3(),
-            -3.0..3.0f64,
-            -3.0..3.0f64,
-            0.0..=1.0f64,
-        );
+        let strategy = (vec3(), vec3(), vec3(), -3.0..3.0f64, -3.0..3.0f64, 0.0..=1.0f64);
         runner
             .run(&strategy, |(dir, v1, v2, lm1, lm2, e)| {
                 let n = Vector3::from(dir);
                 prop_assume!(n.norm() > 1e-3);
                 let (m1, m2) = (10f64.powf(lm1), 10f64.powf(lm2));
-                let mut a = Body {
-                    position: Vector3::zeros(),
-                    velocity: Vector3::from(v1),
-                    mass: m1,
-                };
-                let mut b = Body {
-                    position: n,
-                    velocity: Vector3::from(v2),
-                    mass: m2,
-                };
+                let mut a = Body { position: Vector3::zeros(), velocity: Vector3::from(v1), mass: m1 };
+                let mut b = Body { position: n, velocity: Vector3::from(v2), mass: m2 };
                 let before = (a, b);
                 let j = resolve_pair(&mut a, &mut b, Restitution::new(e).unwrap());
                 let p0 = before.0.velocity * m1 + before.1.velocity * m2;
@@ -237,10 +199,7 @@ mod tests {
                     let scale = m1 * (before.0.velocity[k].abs() + a.velocity[k].abs())
                         + m2 * (before.1.velocity[k].abs() + b.velocity[k].abs())
                         + 2.0 * jn;
-                    prop_assert!(
-                        (p1[k] - p0[k]).abs() <= 8.0 * EPS * scale,
-                        "momentum {k}: {p0} → {p1}"
-                    );
+                    prop_assert!((p1[k] - p0[k]).abs() <= 8.0 * EPS * scale, "momentum {k}: {p0} → {p1}");
                 }
                 let ke = |x: &Body<3>| 0.5 * x.mass * x.velocity.norm_squared();
                 let (k0, k1) = (ke(&before.0) + ke(&before.1), ke(&a) + ke(&b));

@@ -34,10 +34,7 @@ impl fmt::Display for NumberError {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         match self {
             NumberError::Malformed(s) => {
-                write!(
-                    f,
-                    "'{s}' is not a number (expected a decimal such as 0.5 or a hex float such as 0x1p-1)"
-                )
+                write!(f, "'{s}' is not a number (expected a decimal such as 0.5 or a hex float such as 0x1p-1)")
             }
             NumberError::NonFinite(s) => write!(f, "'{s}' is not a finite f64"),
             NumberError::NotANumber(s) => write!(f, "{s} is not a number or a string holding one"),
@@ -55,14 +52,9 @@ pub fn parse_text(text: &str) -> Result<f64, NumberError> {
         quadratic::hex::parse(t).map_err(|_| NumberError::Malformed(text.to_string()))?
     } else {
         // Rust also accepts "inf"/"nan"/"infinity": those are caught as non-finite below.
-        t.parse::<f64>()
-            .map_err(|_| NumberError::Malformed(text.to_string()))?
+        t.parse::<f64>().map_err(|_| NumberError::Malformed(text.to_string()))?
     };
-    if value.is_finite() {
-        Ok(value)
-    } else {
-        Err(NumberError::NonFinite(text.to_string()))
-    }
+    if value.is_finite() { Ok(value) } else { Err(NumberError::NonFinite(text.to_string())) }
 }
 
 /// Reads a JSON number (its exact source text, thanks to serde_json's `arbitrary_precision`)
@@ -108,22 +100,13 @@ mod tests {
         assert_eq!(parse_text("0.1").unwrap(), 0.1);
         assert_eq!(parse_text(" -0x1.8p+1 ").unwrap(), -3.0);
         // Halfway between 1 and 1 + 2⁻⁵², then a hair above: must round up.
-        assert_eq!(
-            parse_text("1.00000000000000011102230246251565404236316680908203125").unwrap(),
-            1.0
-        );
+        assert_eq!(parse_text("1.00000000000000011102230246251565404236316680908203125").unwrap(), 1.0);
         assert_eq!(
             parse_text("1.000000000000000111022302462515654042363166809082031250001").unwrap(),
             1.0 + f64::EPSILON
         );
-        assert_eq!(
-            parse_text("4.9406564584124654e-324").unwrap(),
-            f64::from_bits(1)
-        );
-        assert!(matches!(
-            parse_text("1e400"),
-            Err(NumberError::NonFinite(_))
-        ));
+        assert_eq!(parse_text("4.9406564584124654e-324").unwrap(), f64::from_bits(1));
+        assert!(matches!(parse_text("1e400"), Err(NumberError::NonFinite(_))));
         assert!(matches!(parse_text("nan"), Err(NumberError::NonFinite(_))));
         assert!(matches!(parse_text("1,5"), Err(NumberError::Malformed(_))));
         assert!(matches!(parse_text("0xzz"), Err(NumberError::Malformed(_))));
@@ -133,16 +116,10 @@ mod tests {
     fn json_numbers_keep_their_exact_text() {
         // A 17+ digit literal that a fast float parser may misround.
         let v: Value = serde_json::from_str("2.2250738585072011e-308").unwrap();
-        assert_eq!(
-            parse_json(&v).unwrap(),
-            "2.2250738585072011e-308".parse::<f64>().unwrap()
-        );
+        assert_eq!(parse_json(&v).unwrap(), "2.2250738585072011e-308".parse::<f64>().unwrap());
         let v: Value = serde_json::from_str("\"0x1p-1074\"").unwrap();
         assert_eq!(parse_json(&v).unwrap(), f64::from_bits(1));
-        assert!(matches!(
-            parse_json(&Value::Bool(true)),
-            Err(NumberError::NotANumber(_))
-        ));
+        assert!(matches!(parse_json(&Value::Bool(true)), Err(NumberError::NotANumber(_))));
     }
 
     #[test]

@@ -67,10 +67,7 @@ pub fn answer_lines<R: BufRead, W: Write, E: Write>(
 fn check_keys(map: &Map<String, Value>, allowed: &[&str]) -> Result<(), String> {
     for key in map.keys() {
         if !allowed.contains(&key.as_str()) {
-            return Err(format!(
-                "unknown key '{key}' (allowed: {})",
-                allowed.join(", ")
-            ));
+            return Err(format!("unknown key '{key}' (allowed: {})", allowed.join(", ")));
         }
     }
     Ok(())
@@ -82,8 +79,7 @@ fn number(map: &Map<String, Value>, key: &str) -> Result<f64, String> {
 }
 
 fn id_text(map: &Map<String, Value>) -> String {
-    map.get("id")
-        .map_or_else(|| "null".to_string(), Value::to_string)
+    map.get("id").map_or_else(|| "null".to_string(), Value::to_string)
 }
 
 fn answer_roots(map: &Map<String, Value>, format: NumberFormat) -> Result<String, String> {
@@ -94,11 +90,7 @@ fn answer_roots(map: &Map<String, Value>, format: NumberFormat) -> Result<String
     Ok(match roots {
         Roots::All => format!("{{\"id\":{id},\"all\":true}}"),
         other => {
-            let list: Vec<String> = other
-                .as_vec()
-                .into_iter()
-                .map(|x| format_json(x, format))
-                .collect();
+            let list: Vec<String> = other.as_vec().into_iter().map(|x| format_json(x, format)).collect();
             format!("{{\"id\":{id},\"roots\":[{}]}}", list.join(","))
         }
     })
@@ -106,79 +98,49 @@ fn answer_roots(map: &Map<String, Value>, format: NumberFormat) -> Result<String
 
 fn vector(map: &Map<String, Value>, key: &str) -> Result<Vec<f64>, String> {
     let value = map.get(key).ok_or_else(|| format!("missing key '{key}'"))?;
-    let items = value
-        .as_array()
-        .ok_or_else(|| format!("{key}: expected an array like [x, y], found {value}"))?;
-    items
-        .iter()
-        .enumerate()
-        .map(|(i, v)| parse_json(v).map_err(|e| format!("{key}[{i}]: {e}")))
-        .collect()
+    let items = value.as_array().ok_or_else(|| format!("{key}: expected an array like [x, y], found {value}"))?;
+    items.iter().enumerate().map(|(i, v)| parse_json(v).map_err(|e| format!("{key}[{i}]: {e}"))).collect()
 }
 
 fn answer_contact(map: &Map<String, Value>, format: NumberFormat) -> Result<String, String> {
     check_keys(map, &["id", "r1", "v1", "R1", "r2", "v2", "R2"])?;
-    let (r1, v1, r2, v2) = (
-        vector(map, "r1")?,
-        vector(map, "v1")?,
-        vector(map, "r2")?,
-        vector(map, "v2")?,
-    );
-    let (big_r1, big_r2) = (number(map, "R1")?, number(map, "R2")?);
-    let time = contact_time_dyn(&r1, &v1, big_r1, &r2, &v2, big_r2)?;
+    let first = DynBall { position: vector(map, "r1")?, velocity: vector(map, "v1")?, radius: number(map, "R1")? };
+    let second = DynBall { position: vector(map, "r2")?, velocity: vector(map, "v2")?, radius: number(map, "R2")? };
+    let time = contact_time_dyn(&first, &second)?;
     let t = time.map_or_else(|| "null".to_string(), |t| format_json(t, format));
     Ok(format!("{{\"id\":{},\"t\":{t}}}", id_text(map)))
 }
 
-/// The contact time for vectors given at run time: 2 or 3 components, all the same length.
+/// A disk (or sphere) whose dimension is known only at run time.
+#[derive(Clone, Debug, PartialEq)]
+pub struct DynBall {
+    /// Position, 2 or 3 components.
+    pub position: Vec<f64>,
+    /// Velocity, as many components as the position.
+    pub velocity: Vec<f64>,
+    /// Radius.
+    pub radius: f64,
+}
+
+/// The contact time of two balls given at run time: 2 or 3 components, all the same length.
 /// `Ok(None)` is "never"; `Ok(Some(0.0))` is "now".
-pub fn contact_time_dyn(
-    r1: &[f64],
-    v1: &[f64],
-    radius1: f64,
-    r2: &[f64],
-    v2: &[f64],
-    radius2: f64,
-) -> Result<Option<f64>, String> {
-    let d = r1.len();
-    for (name, v) in [("v1", v1), ("r2", r2), ("v2", v2)] {
+pub fn contact_time_dyn(first: &DynBall, second: &DynBall) -> Result<Option<f64>, String> {
+    let d = first.position.len();
+    for (name, v) in [("v1", &first.velocity), ("r2", &second.position), ("v2", &second.velocity)] {
         if v.len() != d {
-            return Err(format!(
-                "{name} has {} components but r1 has {d}; all vectors need the same",
-                v.len()
-            ));
+            return Err(format!("{name} has {} components but r1 has {d}; all vectors need the same", v.len()));
         }
     }
-    fn run<const D: usize>(
-        r1: &[f64],
-        v1: &[f64],
-        radius1: f64,
-        r2: &[f64],
-        v2: &[f64],
-        radius2: f64,
-    ) -> Result<Option<f64>, String> {
+    fn fixed<const D: usize>(b: &DynBall) -> Ball<D> {
         let arr = |s: &[f64]| -> [f64; D] { s.try_into().expect("length checked") };
-        let p = Ball {
-            position: arr(r1),
-            velocity: arr(v1),
-            radius: radius1,
-        };
-        let q = Ball {
-            position: arr(r2),
-            velocity: arr(v2),
-            radius: radius2,
-        };
-        quadratic::contact_time(&p, &q)
-            .map(|c| c.time())
-            .map_err(|e| e.to_string())
+        Ball { position: arr(&b.position), velocity: arr(&b.velocity), radius: b.radius }
     }
-    match d {
-        2 => run::<2>(r1, v1, radius1, r2, v2, radius2),
-        3 => run::<3>(r1, v1, radius1, r2, v2, radius2),
-        _ => Err(format!(
-            "vectors must have 2 (disks) or 3 (spheres) components, r1 has {d}"
-        )),
-    }
+    let contact = match d {
+        2 => quadratic::contact_time(&fixed::<2>(first), &fixed::<2>(second)),
+        3 => quadratic::contact_time(&fixed::<3>(first), &fixed::<3>(second)),
+        _ => return Err(format!("vectors must have 2 (disks) or 3 (spheres) components, r1 has {d}")),
+    };
+    contact.map(|c| c.time()).map_err(|e| e.to_string())
 }
 
 #[cfg(test)]
@@ -189,11 +151,7 @@ mod tests {
         let mut out = Vec::new();
         let mut err = Vec::new();
         let failed = answer_lines(query, input.as_bytes(), &mut out, &mut err, format).unwrap();
-        (
-            String::from_utf8(out).unwrap(),
-            String::from_utf8(err).unwrap(),
-            failed,
-        )
+        (String::from_utf8(out).unwrap(), String::from_utf8(err).unwrap(), failed)
     }
 
     #[test]
@@ -225,11 +183,7 @@ mod tests {
         let lines: Vec<&str> = err.lines().collect();
         assert!(lines[0].starts_with("line 3: not valid JSON"), "{err}");
         assert_eq!(lines[1], "line 7: missing key 'c'");
-        assert!(
-            lines[2].starts_with("line 8: a: '1e")
-                && lines[2].ends_with("999' is not a finite f64"),
-            "{err}"
-        );
+        assert!(lines[2].starts_with("line 8: a: '1e") && lines[2].ends_with("999' is not a finite f64"), "{err}");
         assert!(lines[3].starts_with("line 9: unknown key 'd'"), "{err}");
     }
 
@@ -243,15 +197,9 @@ mod tests {
             "{\"id\": 5, \"r1\": [0, 0], \"v1\": [1, 0, 0], \"R1\": 1, \"r2\": [1, 0], \"v2\": [0, 0], \"R2\": 1}\n",
         );
         let (out, err, failed) = run(Query::ContactTime, input, NumberFormat::Hex);
-        assert_eq!(
-            out,
-            "{\"id\":1,\"t\":\"0x1p+0\"}\n{\"id\":2,\"t\":null}\n{\"id\":3,\"t\":\"0x0p+0\"}\n"
-        );
+        assert_eq!(out, "{\"id\":1,\"t\":\"0x1p+0\"}\n{\"id\":2,\"t\":null}\n{\"id\":3,\"t\":\"0x0p+0\"}\n");
         assert_eq!(failed, 2);
         assert!(err.contains("line 4: R1 = -1 is negative"), "{err}");
-        assert!(
-            err.contains("line 5: v1 has 3 components but r1 has 2"),
-            "{err}"
-        );
+        assert!(err.contains("line 5: v1 has 3 components but r1 has 2"), "{err}");
     }
 }

@@ -158,10 +158,7 @@ impl std::error::Error for ContactError {}
 /// let c = Ball { position: [3.0, 0.0], velocity: [1.0, 0.0], radius: 0.5 };
 /// assert_eq!(contact_time(&a, &c), Ok(Contact::Never(Miss::NoRelativeMotion)));
 /// ```
-pub fn contact_time<const D: usize>(
-    first: &Ball<D>,
-    second: &Ball<D>,
-) -> Result<Contact, ContactError> {
+pub fn contact_time<const D: usize>(first: &Ball<D>, second: &Ball<D>) -> Result<Contact, ContactError> {
     match filtered(first, second) {
         Some(contact) => Ok(contact),
         None => validated_exact(first, second),
@@ -172,20 +169,11 @@ pub fn contact_time<const D: usize>(
 /// the exact path.
 #[cold]
 #[inline(never)]
-fn validated_exact<const D: usize>(
-    first: &Ball<D>,
-    second: &Ball<D>,
-) -> Result<Contact, ContactError> {
+fn validated_exact<const D: usize>(first: &Ball<D>, second: &Ball<D>) -> Result<Contact, ContactError> {
     let valid = [first, second].iter().all(|b| {
-        b.position.iter().chain(&b.velocity).all(|x| x.is_finite())
-            && b.radius.is_finite()
-            && b.radius >= 0.0
+        b.position.iter().chain(&b.velocity).all(|x| x.is_finite()) && b.radius.is_finite() && b.radius >= 0.0
     });
-    if valid {
-        Ok(exact_full(first, second))
-    } else {
-        Err(first_invalid(first, second))
-    }
+    if valid { Ok(exact_full(first, second)) } else { Err(first_invalid(first, second)) }
 }
 
 /// The first offending input (cold path of [`contact_time`]).
@@ -193,27 +181,17 @@ fn validated_exact<const D: usize>(
 fn first_invalid<const D: usize>(first: &Ball<D>, second: &Ball<D>) -> ContactError {
     for (ball, b) in [(1u8, first), (2u8, second)] {
         for i in 0..D {
-            for (field, value) in [
-                (Field::Position(i), b.position[i]),
-                (Field::Velocity(i), b.velocity[i]),
-            ] {
+            for (field, value) in [(Field::Position(i), b.position[i]), (Field::Velocity(i), b.velocity[i])] {
                 if !value.is_finite() {
                     return ContactError::NonFinite { ball, field, value };
                 }
             }
         }
         if !b.radius.is_finite() {
-            return ContactError::NonFinite {
-                ball,
-                field: Field::Radius,
-                value: b.radius,
-            };
+            return ContactError::NonFinite { ball, field: Field::Radius, value: b.radius };
         }
         if b.radius < 0.0 {
-            return ContactError::NegativeRadius {
-                ball,
-                value: b.radius,
-            };
+            return ContactError::NegativeRadius { ball, value: b.radius };
         }
     }
     unreachable!("first_invalid called on valid input")
@@ -242,15 +220,9 @@ fn exact_full<const D: usize>(first: &Ball<D>, second: &Ball<D>) -> Contact {
     // drop subnormal bits of inputs 2²⁰⁰⁰ times smaller than the largest — see the contract).
     let (dr, dv, sigma) = differences(first, second, 0, 0);
     let safe = |m: f64| m < pow2(1020);
-    let (lpre, vpre) = (
-        if safe(max_length(&dr, sigma)) { 0 } else { -4 },
-        if safe(max_velocity(&dv)) { 0 } else { -4 },
-    );
-    let (dr, dv, sigma) = if lpre == 0 && vpre == 0 {
-        (dr, dv, sigma)
-    } else {
-        differences(first, second, lpre, vpre)
-    };
+    let (lpre, vpre) =
+        (if safe(max_length(&dr, sigma)) { 0 } else { -4 }, if safe(max_velocity(&dv)) { 0 } else { -4 });
+    let (dr, dv, sigma) = if lpre == 0 && vpre == 0 { (dr, dv, sigma) } else { differences(first, second, lpre, vpre) };
     contact_of_differences(&dr, &dv, sigma, vpre - lpre)
 }
 
@@ -297,12 +269,7 @@ fn max_velocity<const D: usize>(dv: &[Pair; D]) -> f64 {
 
 /// The contact given exact differences `Δr`, `Δv`, `σ` as (hi, lo) pairs, by the exact
 /// path; the resulting time is multiplied by `2^time_exp`.
-fn contact_of_differences<const D: usize>(
-    dr: &[Pair; D],
-    dv: &[Pair; D],
-    sigma: Pair,
-    time_exp: i32,
-) -> Contact {
+fn contact_of_differences<const D: usize>(dr: &[Pair; D], dv: &[Pair; D], sigma: Pair, time_exp: i32) -> Contact {
     // Δv = 0 exactly iff every TwoSum head is 0.
     let vmax = max_velocity(dv);
     if vmax == 0.0 {
@@ -564,10 +531,7 @@ fn exact<const D: usize>(dr: &[Pair; D], dv: &[Pair; D], sigma: Pair, time_exp: 
         return Contact::Never(Miss::PathsMiss);
     }
     let root = disc.to_dd().sqrt();
-    let root = Dd {
-        hi: scale2(root.hi, -k),
-        lo: scale2(root.lo, -k),
-    };
+    let root = Dd { hi: scale2(root.hi, -k), lo: scale2(root.lo, -k) };
     let t = c.to_dd().div(b.neg().to_dd().add(root));
     Contact::At(t.to_f64_scaled(time_exp).max(f64::from_bits(1)))
 }
@@ -577,50 +541,27 @@ mod tests {
     use super::*;
 
     fn ball(position: [f64; 2], velocity: [f64; 2], radius: f64) -> Ball<2> {
-        Ball {
-            position,
-            velocity,
-            radius,
-        }
+        Ball { position, velocity, radius }
     }
 
     /// Runs both paths (the filter where it applies, and the exact one) and checks they agree.
     fn both(p: &Ball<2>, q: &Ball<2>) -> Contact {
         let fast = contact_time(p, q).unwrap();
-        assert_eq!(
-            fast,
-            contact_time_exact_path(p, q),
-            "filter and exact path disagree"
-        );
+        assert_eq!(fast, contact_time_exact_path(p, q), "filter and exact path disagree");
         fast
     }
 
     #[test]
     fn head_on_and_classification_cases() {
         let a = ball([0.0, 0.0], [1.0, 0.0], 0.5);
-        assert_eq!(
-            both(&a, &ball([3.0, 0.0], [-1.0, 0.0], 0.5)),
-            Contact::At(1.0)
-        );
-        assert_eq!(
-            both(&a, &ball([3.0, 0.0], [2.0, 0.0], 0.5)),
-            Contact::Never(Miss::Receding)
-        );
-        assert_eq!(
-            both(&a, &ball([3.0, 5.0], [-1.0, 0.0], 0.5)),
-            Contact::Never(Miss::PathsMiss)
-        );
+        assert_eq!(both(&a, &ball([3.0, 0.0], [-1.0, 0.0], 0.5)), Contact::At(1.0));
+        assert_eq!(both(&a, &ball([3.0, 0.0], [2.0, 0.0], 0.5)), Contact::Never(Miss::Receding));
+        assert_eq!(both(&a, &ball([3.0, 5.0], [-1.0, 0.0], 0.5)), Contact::Never(Miss::PathsMiss));
         // Exact graze: impact parameter equals σ = 1.
-        assert_eq!(
-            both(&a, &ball([3.0, 1.0], [-1.0, 0.0], 0.5)),
-            Contact::Never(Miss::PathsMiss)
-        );
+        assert_eq!(both(&a, &ball([3.0, 1.0], [-1.0, 0.0], 0.5)), Contact::Never(Miss::PathsMiss));
         // Overlapping and approaching: now; overlapping and separating: never.
         assert_eq!(both(&a, &ball([0.5, 0.0], [-1.0, 0.0], 0.5)), Contact::Now);
-        assert_eq!(
-            both(&a, &ball([0.5, 0.0], [3.0, 0.0], 0.5)),
-            Contact::Never(Miss::Receding)
-        );
+        assert_eq!(both(&a, &ball([0.5, 0.0], [3.0, 0.0], 0.5)), Contact::Never(Miss::Receding));
         // Touching exactly and approaching.
         assert_eq!(both(&a, &ball([1.0, 0.0], [0.0, 0.0], 0.5)), Contact::Now);
     }
@@ -644,9 +585,6 @@ mod tests {
         assert_eq!(e.to_string(), "v1[1] = NaN is not finite");
         let q = ball([0.0, 0.0], [0.0, 0.0], -2.0);
         let p = ball([0.0, 0.0], [0.0, 0.0], 1.0);
-        assert!(matches!(
-            contact_time(&p, &q),
-            Err(ContactError::NegativeRadius { ball: 2, .. })
-        ));
+        assert!(matches!(contact_time(&p, &q), Err(ContactError::NegativeRadius { ball: 2, .. })));
     }
 }

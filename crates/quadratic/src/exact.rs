@@ -136,10 +136,7 @@ impl Dd {
     /// `-self`, exactly.
     #[inline]
     pub fn neg(self) -> Self {
-        Dd {
-            hi: -self.hi,
-            lo: -self.lo,
-        }
+        Dd { hi: -self.hi, lo: -self.lo }
     }
 
     /// `self + other`; accurate to ~2⁻¹⁰⁴ relative when both have the same sign.
@@ -322,11 +319,8 @@ impl Expansion {
 
     /// `self + other`, exactly.
     pub fn add(&self, other: &Expansion) -> Expansion {
-        let (mut acc, rest) = if self.c.len() >= other.c.len() {
-            (self.clone(), &other.c)
-        } else {
-            (other.clone(), &self.c)
-        };
+        let (mut acc, rest) =
+            if self.c.len() >= other.c.len() { (self.clone(), &other.c) } else { (other.clone(), &self.c) };
         for &x in rest {
             acc = acc.add_f64(x);
         }
@@ -335,9 +329,7 @@ impl Expansion {
 
     /// `-self`, exactly.
     pub fn neg(&self) -> Expansion {
-        Expansion {
-            c: self.c.iter().map(|x| -x).collect(),
-        }
+        Expansion { c: self.c.iter().map(|x| -x).collect() }
     }
 
     /// `self − other`, exactly.
@@ -387,14 +379,7 @@ impl Expansion {
 
     /// `self · 2^k`, exact when no component leaves the normal range.
     pub fn scale2(&self, k: i32) -> Expansion {
-        Expansion {
-            c: self
-                .c
-                .iter()
-                .map(|&x| scale2(x, k))
-                .filter(|&x| x != 0.0)
-                .collect(),
-        }
+        Expansion { c: self.c.iter().map(|&x| scale2(x, k)).filter(|&x| x != 0.0).collect() }
     }
 
     /// The same value with fewer, non-adjacent components (Shewchuk's COMPRESS); afterwards

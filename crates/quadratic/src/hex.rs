@@ -41,20 +41,12 @@ pub fn format(x: f64) -> String {
     if biased == 0 && frac == 0 {
         return format!("{sign}0x0p+0");
     }
-    let (lead, exp) = if biased == 0 {
-        (0, -1022)
-    } else {
-        (1, biased - 1023)
-    };
+    let (lead, exp) = if biased == 0 { (0, -1022) } else { (1, biased - 1023) };
     let mut digits = format!("{frac:013x}");
     while digits.ends_with('0') {
         digits.pop();
     }
-    let dot = if digits.is_empty() {
-        String::new()
-    } else {
-        format!(".{digits}")
-    };
+    let dot = if digits.is_empty() { String::new() } else { format!(".{digits}") };
     format!("{sign}0x{lead}{dot}p{exp:+}")
 }
 
@@ -67,29 +59,17 @@ pub fn parse(text: &str) -> Result<f64, HexError> {
         Some(b'+') => (false, &s[1..]),
         _ => (false, s),
     };
-    let s = s
-        .strip_prefix("0x")
-        .or_else(|| s.strip_prefix("0X"))
-        .ok_or_else(bad)?;
+    let s = s.strip_prefix("0x").or_else(|| s.strip_prefix("0X")).ok_or_else(bad)?;
     let (mant, exp) = match s.find(['p', 'P']) {
         Some(i) => (&s[..i], &s[i + 1..]),
         None => (s, "0"),
     };
     let exp: i64 = {
         let e = exp.strip_prefix('+').unwrap_or(exp);
-        if e.is_empty()
-            || !e
-                .trim_start_matches('-')
-                .bytes()
-                .all(|b| b.is_ascii_digit())
-        {
+        if e.is_empty() || !e.trim_start_matches('-').bytes().all(|b| b.is_ascii_digit()) {
             return Err(bad());
         }
-        e.parse::<i64>().unwrap_or(if e.starts_with('-') {
-            i64::MIN / 4
-        } else {
-            i64::MAX / 4
-        })
+        e.parse::<i64>().unwrap_or(if e.starts_with('-') { i64::MIN / 4 } else { i64::MAX / 4 })
     };
     let (int, frac) = match mant.find('.') {
         Some(i) => (&mant[..i], &mant[i + 1..]),
@@ -117,11 +97,7 @@ pub fn parse(text: &str) -> Result<f64, HexError> {
             }
         }
     }
-    let value = if m == 0 {
-        0.0
-    } else {
-        round_to_f64(m, sticky, bin_exp)
-    };
+    let value = if m == 0 { 0.0 } else { round_to_f64(m, sticky, bin_exp) };
     Ok(if neg { -value } else { value })
 }
 
@@ -141,17 +117,9 @@ fn round_to_f64(m: u64, sticky: bool, e: i64) -> f64 {
         (0, false, true)
     } else {
         let q = if shift == 64 { 0 } else { m >> shift };
-        let dropped = if shift == 64 {
-            m
-        } else {
-            m & ((1u64 << shift) - 1)
-        };
+        let dropped = if shift == 64 { m } else { m & ((1u64 << shift) - 1) };
         let half = 1u64 << (shift - 1);
-        (
-            q,
-            dropped & half != 0,
-            (dropped & (half - 1)) != 0 || sticky,
-        )
+        (q, dropped & half != 0, (dropped & (half - 1)) != 0 || sticky)
     };
     if rem_half && (rem_rest || q & 1 == 1) {
         q += 1;
@@ -166,22 +134,8 @@ mod tests {
 
     #[test]
     fn round_trips_and_known_values() {
-        for x in [
-            1.0,
-            3.0,
-            0.1,
-            -2.5e-300,
-            f64::MAX,
-            f64::MIN_POSITIVE,
-            f64::from_bits(1),
-            1e-310,
-        ] {
-            assert_eq!(
-                parse(&format(x)).unwrap().to_bits(),
-                x.to_bits(),
-                "{}",
-                format(x)
-            );
+        for x in [1.0, 3.0, 0.1, -2.5e-300, f64::MAX, f64::MIN_POSITIVE, f64::from_bits(1), 1e-310] {
+            assert_eq!(parse(&format(x)).unwrap().to_bits(), x.to_bits(), "{}", format(x));
         }
         assert_eq!(format(3.0), "0x1.8p+1");
         assert_eq!(format(f64::from_bits(1)), "0x0.0000000000001p-1022");
@@ -189,10 +143,7 @@ mod tests {
         assert_eq!(parse("0x1p-1075").unwrap(), 0.0); // tie to even
         assert_eq!(parse("0x1.8p-1074").unwrap(), f64::from_bits(2)); // tie to even
         assert_eq!(parse("0x1.00000000000008p+0").unwrap(), 1.0); // tie to even
-        assert_eq!(
-            parse("0x1.000000000000080000001p+0").unwrap(),
-            1.0 + f64::EPSILON
-        );
+        assert_eq!(parse("0x1.000000000000080000001p+0").unwrap(), 1.0 + f64::EPSILON);
         assert_eq!(parse("-0X.8P1").unwrap(), -1.0);
         assert_eq!(parse("0x1p1024").unwrap(), f64::INFINITY);
         assert!(parse("1.5").is_err());

@@ -40,11 +40,7 @@ pub struct ContactCase {
 }
 
 const fn disk(x: f64, y: f64, vx: f64, vy: f64, radius: f64) -> Ball<2> {
-    Ball {
-        position: [x, y],
-        velocity: [vx, vy],
-        radius,
-    }
+    Ball { position: [x, y], velocity: [vx, vy], radius }
 }
 
 const fn bits(b: u64) -> f64 {
@@ -140,41 +136,11 @@ pub const ROOT_CASES: &[RootCase] = &[
         c: 0.0,
         exact: Roots::Two(0.0, bits(1 << 14)),
     },
-    RootCase {
-        name: "linear: 0x² + 3x − 1",
-        a: 0.0,
-        b: 3.0,
-        c: -1.0,
-        exact: Roots::One(bits(0x3fd5555555555555)),
-    },
-    RootCase {
-        name: "every x: 0 = 0 (with −0.0)",
-        a: -0.0,
-        b: 0.0,
-        c: -0.0,
-        exact: Roots::All,
-    },
-    RootCase {
-        name: "no x: 0x² + 0x + 1",
-        a: 0.0,
-        b: -0.0,
-        c: 1.0,
-        exact: Roots::None,
-    },
-    RootCase {
-        name: "c = 0: x² − 5x",
-        a: 1.0,
-        b: -5.0,
-        c: 0.0,
-        exact: Roots::Two(0.0, 5.0),
-    },
-    RootCase {
-        name: "b = c = 0: 7x² (double root 0)",
-        a: 7.0,
-        b: 0.0,
-        c: -0.0,
-        exact: Roots::One(0.0),
-    },
+    RootCase { name: "linear: 0x² + 3x − 1", a: 0.0, b: 3.0, c: -1.0, exact: Roots::One(bits(0x3fd5555555555555)) },
+    RootCase { name: "every x: 0 = 0 (with −0.0)", a: -0.0, b: 0.0, c: -0.0, exact: Roots::All },
+    RootCase { name: "no x: 0x² + 0x + 1", a: 0.0, b: -0.0, c: 1.0, exact: Roots::None },
+    RootCase { name: "c = 0: x² − 5x", a: 1.0, b: -5.0, c: 0.0, exact: Roots::Two(0.0, 5.0) },
+    RootCase { name: "b = c = 0: 7x² (double root 0)", a: 7.0, b: 0.0, c: -0.0, exact: Roots::One(0.0) },
 ];
 
 /// The contact-time cases (unit-diameter disks unless stated).
@@ -287,9 +253,7 @@ pub fn roots_agree(got: &Roots, exact: &Roots) -> bool {
     match (got, exact) {
         (Roots::None, Roots::None) | (Roots::All, Roots::All) => true,
         (Roots::One(x), Roots::One(y)) => within_one_ulp(*x, *y),
-        (Roots::Two(x1, x2), Roots::Two(y1, y2)) => {
-            within_one_ulp(*x1, *y1) && within_one_ulp(*x2, *y2)
-        }
+        (Roots::Two(x1, x2), Roots::Two(y1, y2)) => within_one_ulp(*x1, *y1) && within_one_ulp(*x2, *y2),
         _ => false,
     }
 }
@@ -335,6 +299,15 @@ pub struct Report {
     pub failures: usize,
 }
 
+/// One case of the plain-text report: verdict, name, then the three answers.
+fn entry(text: &mut String, ok: &str, name: &str, naive: (String, bool), got: String, exact: String) {
+    let mark = if naive.1 { "" } else { "  ✗" };
+    writeln!(text, "  [{ok}] {name}").unwrap();
+    writeln!(text, "      textbook: {}{mark}", naive.0).unwrap();
+    writeln!(text, "      collide:  {got}").unwrap();
+    writeln!(text, "      exact:    {exact}").unwrap();
+}
+
 /// Recomputes every reference case with this crate and with the textbook formula.
 pub fn check_all() -> Report {
     let mut text = String::new();
@@ -348,44 +321,18 @@ pub fn check_all() -> Report {
         let got = solve(case.a, case.b, case.c).expect("reference inputs are finite");
         let naive = textbook::solve(case.a, case.b, case.c);
         let ok = verdict(roots_agree(&got, &case.exact));
-        let naive_mark = if roots_agree(&naive, &case.exact) {
-            ""
-        } else {
-            "  ✗"
-        };
-        writeln!(text, "  [{ok}] {}", case.name).unwrap();
-        writeln!(
-            text,
-            "      textbook: {}{naive_mark}",
-            describe_roots(&naive)
-        )
-        .unwrap();
-        writeln!(text, "      collide:  {}", describe_roots(&got)).unwrap();
-        writeln!(text, "      exact:    {}", describe_roots(&case.exact)).unwrap();
+        let naive_ok = roots_agree(&naive, &case.exact);
+        let [naive, got, exact] = [naive, got, case.exact].map(|r| describe_roots(&r));
+        entry(&mut text, ok, case.name, (naive, naive_ok), got, exact);
     }
     writeln!(text, "Contact time of two disks").unwrap();
     for case in CONTACT_CASES {
         let got = contact_time(&case.first, &case.second).expect("reference inputs are valid");
         let naive = textbook::contact_time(&case.first, &case.second);
         let ok = verdict(contacts_agree(&got, &case.exact));
-        let naive_mark = if contacts_agree(&naive, &case.exact) {
-            ""
-        } else {
-            "  ✗"
-        };
-        writeln!(text, "  [{ok}] {}", case.name).unwrap();
-        writeln!(
-            text,
-            "      textbook: {}{naive_mark}",
-            describe_contact(&naive)
-        )
-        .unwrap();
-        writeln!(text, "      collide:  {}", describe_contact(&got)).unwrap();
-        writeln!(text, "      exact:    {}", describe_contact(&case.exact)).unwrap();
+        let naive_ok = contacts_agree(&naive, &case.exact);
+        let [naive, got, exact] = [naive, got, case.exact].map(|c| describe_contact(&c));
+        entry(&mut text, ok, case.name, (naive, naive_ok), got, exact);
     }
-    Report {
-        text,
-        cases: ROOT_CASES.len() + CONTACT_CASES.len(),
-        failures,
-    }
+    Report { text, cases: ROOT_CASES.len() + CONTACT_CASES.len(), failures }
 }

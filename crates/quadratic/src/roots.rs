@@ -42,8 +42,7 @@
 //! The tests in `crates/quadratic/tests/` prove this against an exact big-integer oracle.
 
 use crate::exact::{
-    Dd, compress_in_place, dd_of_compressed, exponent, grow_in_place, pow2, scale2, sign_of,
-    two_prod, two_sum,
+    Dd, compress_in_place, dd_of_compressed, exponent, grow_in_place, pow2, scale2, sign_of, two_prod, two_sum,
 };
 use core::cmp::Ordering;
 use core::fmt;
@@ -106,10 +105,7 @@ impl fmt::Display for SolveError {
                     Coefficient::B => "b",
                     Coefficient::C => "c",
                 };
-                write!(
-                    f,
-                    "coefficient {name} = {value} is not finite (NaN and ±inf have no roots to speak of)"
-                )
+                write!(f, "coefficient {name} = {value} is not finite (NaN and ±inf have no roots to speak of)")
             }
         }
     }
@@ -130,11 +126,7 @@ const DOMINANCE: i32 = 220;
 /// assert_eq!(solve(1.0, -1e8, 1.0), Ok(Roots::Two(1e-8, 1e8 - 1e-8)));
 /// ```
 pub fn solve(a: f64, b: f64, c: f64) -> Result<Roots, SolveError> {
-    for (coefficient, value) in [
-        (Coefficient::A, a),
-        (Coefficient::B, b),
-        (Coefficient::C, c),
-    ] {
+    for (coefficient, value) in [(Coefficient::A, a), (Coefficient::B, b), (Coefficient::C, c)] {
         if !value.is_finite() {
             return Err(SolveError::NonFinite { coefficient, value });
         }
@@ -150,11 +142,7 @@ fn plus_zero(x: f64) -> f64 {
 
 fn two_sorted(x: f64, y: f64) -> Roots {
     let (x, y) = (plus_zero(x), plus_zero(y));
-    if x <= y {
-        Roots::Two(x, y)
-    } else {
-        Roots::Two(y, x)
-    }
+    if x <= y { Roots::Two(x, y) } else { Roots::Two(y, x) }
 }
 
 fn solve_finite(a: f64, b: f64, c: f64) -> Roots {
@@ -198,14 +186,7 @@ fn solve_finite(a: f64, b: f64, c: f64) -> Roots {
     // roots) the four terms are summed exactly as an expansion on the stack.
     let mut terms = [0.0; 4];
     let (sign, value) = if d.abs() >= pow2(-20) * (p + q.abs()) {
-        (
-            if d > 0.0 {
-                Ordering::Greater
-            } else {
-                Ordering::Less
-            },
-            Dd::new(d, de + (pe - qe)),
-        )
+        (if d > 0.0 { Ordering::Greater } else { Ordering::Less }, Dd::new(d, de + (pe - qe)))
     } else {
         let mut len = 0;
         for term in [pe, -qe, de, d] {
@@ -222,10 +203,7 @@ fn solve_finite(a: f64, b: f64, c: f64) -> Roots {
             let signed = if b1 > 0.0 { root } else { root.neg() };
             // q = −(b' + sign(b')√Δ')/2: the two terms have the same sign, no cancellation.
             let q = Dd::from_f64(b1).add(signed);
-            let q = Dd {
-                hi: -0.5 * q.hi,
-                lo: -0.5 * q.lo,
-            };
+            let q = Dd { hi: -0.5 * q.hi, lo: -0.5 * q.lo };
             let y1 = q.div(Dd::from_f64(a1));
             let y2 = Dd::from_f64(c1).div(q);
             two_sorted(y1.to_f64_scaled(s), y2.to_f64_scaled(s))
@@ -247,10 +225,7 @@ fn symmetric_pair(a: f64, c: f64) -> Roots {
         e -= 1;
     }
     let an = scale2(a.abs(), -ea);
-    let r = Dd::from_f64(cn)
-        .div(Dd::from_f64(an))
-        .sqrt()
-        .to_f64_scaled(e / 2);
+    let r = Dd::from_f64(cn).div(Dd::from_f64(an)).sqrt().to_f64_scaled(e / 2);
     Roots::Two(-r, r)
 }
 
@@ -283,18 +258,10 @@ mod tests {
     #[test]
     fn extreme_scales_neither_overflow_nor_underflow() {
         // (x − 2^600)(x − 2^601) times 2^-900: coefficients 2^-900, −3·2^-300, 2^301.
-        let r = solve_finite(
-            scale2(1.0, -900),
-            -3.0 * scale2(1.0, -300),
-            scale2(1.0, 301),
-        );
+        let r = solve_finite(scale2(1.0, -900), -3.0 * scale2(1.0, -300), scale2(1.0, 301));
         assert_eq!(r, Roots::Two(scale2(1.0, 600), scale2(1.0, 601)));
         // (x − 1)(x − 2) times 2^1000: b² overflows in f64, the roots are tame.
-        let r = solve_finite(
-            scale2(1.0, 1000),
-            -3.0 * scale2(1.0, 1000),
-            scale2(1.0, 1001),
-        );
+        let r = solve_finite(scale2(1.0, 1000), -3.0 * scale2(1.0, 1000), scale2(1.0, 1001));
         assert_eq!(r, Roots::Two(1.0, 2.0));
     }
 }

@@ -25,11 +25,7 @@ pub fn solve(a: f64, b: f64, c: f64) -> Roots {
     let r = disc.sqrt();
     let x1 = (-b - r) / (2.0 * a);
     let x2 = (-b + r) / (2.0 * a);
-    if x1 <= x2 {
-        Roots::Two(x1, x2)
-    } else {
-        Roots::Two(x2, x1)
-    }
+    if x1 <= x2 { Roots::Two(x1, x2) } else { Roots::Two(x2, x1) }
 }
 
 /// The seed's contact time (eq. 5–7) in plain f64: `a = |Δv|²`, `b = 2⟨Δv|Δr⟩`,

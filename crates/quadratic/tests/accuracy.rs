@@ -60,10 +60,7 @@ fn publish(title: &str, rows: &[String]) {
     let table = format!("### {title}\n\n{HEADER}\n{}\n", rows.join("\n"));
     println!("{table}");
     let dir = std::path::Path::new(env!("CARGO_TARGET_TMPDIR"));
-    let path = dir.join(format!(
-        "accuracy-{}.md",
-        title.split_whitespace().next().unwrap().to_lowercase()
-    ));
+    let path = dir.join(format!("accuracy-{}.md", title.split_whitespace().next().unwrap().to_lowercase()));
     std::fs::write(path, &table).unwrap();
 }
 
@@ -79,9 +76,7 @@ fn quadratic_solver_contract_on_every_family() {
             let mut s = score.borrow_mut();
             s.cases += 1;
             s.wrong += usize::from(!check.count_ok);
-            s.max_ulps = s
-                .max_ulps
-                .max(if check.count_ok { check.max_ulps } else { 0.0 });
+            s.max_ulps = s.max_ulps.max(if check.count_ok { check.max_ulps } else { 0.0 });
             if naive.count_ok {
                 s.textbook_over_1ulp += usize::from(!(naive.max_ulps <= 1.0));
                 s.textbook_max_ulps = s.textbook_max_ulps.max(naive.max_ulps);
@@ -89,10 +84,7 @@ fn quadratic_solver_contract_on_every_family() {
                 s.textbook_wrong += 1;
             }
             drop(s);
-            prop_assert!(
-                check.count_ok,
-                "wrong root count for ({a:e}, {b:e}, {c:e}): {got:?}"
-            );
+            prop_assert!(check.count_ok, "wrong root count for ({a:e}, {b:e}, {c:e}): {got:?}");
             prop_assert!(
                 check.max_ulps <= 1.0,
                 "({a:e}, {b:e}, {c:e}) → {got:?}: {} ulp from the exact root",
@@ -108,9 +100,7 @@ fn quadratic_solver_contract_on_every_family() {
     publish("Quadratic solver", &rows);
 }
 
-fn score_contacts<const D: usize>(
-    families: Vec<(&'static str, BoxedStrategy<(Ball<D>, Ball<D>)>)>,
-) -> Vec<String> {
+fn score_contacts<const D: usize>(families: Vec<(&'static str, BoxedStrategy<(Ball<D>, Ball<D>)>)>) -> Vec<String> {
     let mut rows = Vec::new();
     for (name, strategy) in families {
         let score = RefCell::new(Score::default());
@@ -118,13 +108,7 @@ fn score_contacts<const D: usize>(
             let got = quadratic::contact_time(&p, &q).expect("valid inputs");
             // The exact path alone must give the identical answer: both paths are proved.
             let slow = quadratic::contact_time_exact_path(&p, &q);
-            prop_assert_eq!(
-                got,
-                slow,
-                "filter and exact path disagree for {:?} {:?}",
-                p,
-                q
-            );
+            prop_assert_eq!(got, slow, "filter and exact path disagree for {:?} {:?}", p, q);
             let exact = exact_contact(&p, &q);
             let naive = textbook::contact_time(&p, &q);
             let ulps = |c: &Contact| match *c {
@@ -146,15 +130,8 @@ fn score_contacts<const D: usize>(
                 s.textbook_wrong += 1;
             }
             drop(s);
-            prop_assert!(
-                class_ok,
-                "{p:?} {q:?}: got {got:?}, exact {:?}",
-                exact.class
-            );
-            prop_assert!(
-                u <= 1.0,
-                "{p:?} {q:?}: {got:?} is {u} ulp from the exact time"
-            );
+            prop_assert!(class_ok, "{p:?} {q:?}: got {got:?}, exact {:?}", exact.class);
+            prop_assert!(u <= 1.0, "{p:?} {q:?}: {got:?} is {u} ulp from the exact time");
             Ok(())
         });
         if let Err(e) = result {
@@ -187,16 +164,8 @@ fn oracle_detects_wrong_answers() {
     // Double root at 3: one root expected, two is wrong.
     assert!(!check_roots(1.0, -6.0, 9.0, &quadratic::Roots::Two(3.0, 3.0)).count_ok);
     // A head-on contact at t = 1: t ± 2 ulps is caught, and the class is exact.
-    let p = Ball {
-        position: [0.0, 0.0],
-        velocity: [1.0, 0.0],
-        radius: 0.5,
-    };
-    let q = Ball {
-        position: [3.0, 0.0],
-        velocity: [-1.0, 0.0],
-        radius: 0.5,
-    };
+    let p = Ball { position: [0.0, 0.0], velocity: [1.0, 0.0], radius: 0.5 };
+    let q = Ball { position: [3.0, 0.0], velocity: [-1.0, 0.0], radius: 0.5 };
     let exact = exact_contact(&p, &q);
     assert_eq!(class3(&exact.class), 2);
     assert!(exact.ulps(1.0) < 1e-9);

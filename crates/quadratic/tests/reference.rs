@@ -35,9 +35,7 @@ fn stored_exact_answers_are_exact() {
         let exact = exact_roots(case.a, case.b, case.c);
         let same = match (exact, case.exact) {
             (Roots::One(x), Roots::One(y)) => x.to_bits() == y.to_bits(),
-            (Roots::Two(x1, x2), Roots::Two(y1, y2)) => {
-                x1.to_bits() == y1.to_bits() && x2.to_bits() == y2.to_bits()
-            }
+            (Roots::Two(x1, x2), Roots::Two(y1, y2)) => x1.to_bits() == y1.to_bits() && x2.to_bits() == y2.to_bits(),
             (x, y) => x == y,
         };
         if !same {
@@ -46,10 +44,7 @@ fn stored_exact_answers_are_exact() {
                 Roots::Two(x, y) => format!("Roots::Two({}, {})", literal(x), literal(y)),
                 other => format!("Roots::{other:?}"),
             };
-            wrong.push(format!(
-                "{}: stored {:?}, exact: {fix}",
-                case.name, case.exact
-            ));
+            wrong.push(format!("{}: stored {:?}, exact: {fix}", case.name, case.exact));
         }
     }
     for case in CONTACT_CASES {
@@ -67,17 +62,10 @@ fn stored_exact_answers_are_exact() {
                 Contact::At(t) => format!("Contact::At({})", literal(t)),
                 other => format!("Contact::{other:?}"),
             };
-            wrong.push(format!(
-                "{}: stored {:?}, exact: {fix}",
-                case.name, case.exact
-            ));
+            wrong.push(format!("{}: stored {:?}, exact: {fix}", case.name, case.exact));
         }
     }
-    assert!(
-        wrong.is_empty(),
-        "stored reference answers are wrong:\n{}",
-        wrong.join("\n")
-    );
+    assert!(wrong.is_empty(), "stored reference answers are wrong:\n{}", wrong.join("\n"));
 }
 
 #[test]
@@ -91,7 +79,9 @@ fn table() -> String {
     let mark = |ok: bool| if ok { "" } else { " ✗" };
     let mut out = String::new();
     out.push_str("### Quadratic `a·x² + b·x + c = 0`\n\n");
-    out.push_str("| case | a, b, c | textbook formula | collide | exact (correctly rounded) |\n|---|---|---|---|---|\n");
+    out.push_str(
+        "| case | a, b, c | textbook formula | collide | exact (correctly rounded) |\n|---|---|---|---|---|\n",
+    );
     for c in ROOT_CASES {
         let naive = textbook::solve(c.a, c.b, c.c);
         let got = solve(c.a, c.b, c.c).unwrap();
@@ -142,10 +132,8 @@ fn readme_table_matches_the_data() {
     const END: &str = "<!-- reference:end -->";
     let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("README.md");
     let readme = std::fs::read_to_string(&path).unwrap();
-    let (start, stop) = (
-        readme.find(BEGIN).expect("begin marker") + BEGIN.len(),
-        readme.find(END).expect("end marker"),
-    );
+    let (start, stop) =
+        (readme.find(BEGIN).expect("begin marker") + BEGIN.len(), readme.find(END).expect("end marker"));
     let fresh = table();
     if readme[start..stop] != fresh {
         if std::env::var_os("UPDATE_REFERENCE").is_some() {

@@ -55,28 +55,14 @@ pub fn quadratic_families() -> Vec<(&'static str, BoxedStrategy<Coeffs>)> {
             (float_exp(-60, 60), float_exp(-60, 60), -6i64..=6)
                 .prop_map(|(a, b, k)| {
                     let c = b * b / (4.0 * a);
-                    (
-                        a,
-                        b,
-                        if c.is_finite() && c != 0.0 {
-                            nudge(c, k)
-                        } else {
-                            1.0
-                        },
-                    )
+                    (a, b, if c.is_finite() && c != 0.0 { nudge(c, k) } else { 1.0 })
                 })
                 .boxed(),
         ),
         (
             // (m·x − n)² scaled: b² = 4ac exactly, with 52-bit products.
             "exact double root",
-            (
-                1u64..(1 << 26),
-                1u64..(1 << 26),
-                any::<bool>(),
-                -400i32..=400,
-                -200i32..=200,
-            )
+            (1u64..(1 << 26), 1u64..(1 << 26), any::<bool>(), -400i32..=400, -200i32..=200)
                 .prop_map(|(m, n, neg, p, q)| {
                     let (m, n) = (m as f64, n as f64);
                     let b = if neg { 2.0 * m * n } else { -2.0 * m * n };
@@ -106,19 +92,12 @@ pub fn quadratic_families() -> Vec<(&'static str, BoxedStrategy<Coeffs>)> {
             "zero coefficients",
             (zero_or(), zero_or(), zero_or()).boxed(),
         ),
-        (
-            "random moderate",
-            (float_exp(-60, 60), float_exp(-60, 60), float_exp(-60, 60)).boxed(),
-        ),
+        ("random moderate", (float_exp(-60, 60), float_exp(-60, 60), float_exp(-60, 60)).boxed()),
     ]
 }
 
 fn zero_or() -> impl Strategy<Value = f64> {
-    prop_oneof![
-        Just(0.0),
-        Just(-0.0),
-        float_exp(-1074, 1023).prop_filter("finite", |x| x.is_finite())
-    ]
+    prop_oneof![Just(0.0), Just(-0.0), float_exp(-1074, 1023).prop_filter("finite", |x| x.is_finite())]
 }
 
 pub fn fibonacci(n: usize) -> Vec<u64> {
@@ -138,11 +117,7 @@ fn unit(theta: f64) -> [f64; 2] {
 }
 
 fn ball<const D: usize>(position: [f64; D], velocity: [f64; D], radius: f64) -> Ball<D> {
-    Ball {
-        position,
-        velocity,
-        radius,
-    }
+    Ball { position, velocity, radius }
 }
 
 /// Contact-time families in 2D.
@@ -153,38 +128,21 @@ pub fn contact_families() -> Vec<(&'static str, BoxedStrategy<Pair2>)> {
         (
             // Centres σ(1 ± k·2⁻⁵²) apart: c ≈ 0, the textbook smaller root cancels.
             "near contact",
-            (
-                radius(),
-                radius(),
-                angle(),
-                -8i64..=8,
-                -10.0..10.0f64,
-                angle(),
-                0.1..2.0f64,
-            )
+            (radius(), radius(), angle(), -8i64..=8, -10.0..10.0f64, angle(), 0.1..2.0f64)
                 .prop_map(|(r1, r2, th, k, x0, phi, speed)| {
                     let d = (r1 + r2) * (1.0 + k as f64 * f64::EPSILON);
                     let u = unit(th);
                     let p = [x0, -x0];
                     let q = [p[0] + d * u[0], p[1] + d * u[1]];
                     let w = unit(phi);
-                    (
-                        ball(p, [0.0, 0.0], r1),
-                        ball(q, [speed * w[0], speed * w[1]], r2),
-                    )
+                    (ball(p, [0.0, 0.0], r1), ball(q, [speed * w[0], speed * w[1]], r2))
                 })
                 .boxed(),
         ),
         (
             // Impact parameter σ(1 + k·2⁻⁵²) at 10⁰–10¹² diameters: hit or miss in the last bits.
             "grazing (axis-aligned)",
-            (
-                radius(),
-                0.0..12.0f64,
-                -4i64..=4,
-                -100.0..100.0f64,
-                0.5..2.0f64,
-            )
+            (radius(), 0.0..12.0f64, -4i64..=4, -100.0..100.0f64, 0.5..2.0f64)
                 .prop_map(|(r, lg, k, x0, speed)| {
                     let sigma = 2.0 * r;
                     let d = sigma * 10f64.powf(lg) + 3.0 * sigma;
@@ -205,76 +163,37 @@ pub fn contact_families() -> Vec<(&'static str, BoxedStrategy<Pair2>)> {
                     let y = nudge(sigma, k);
                     let (c, s) = (th.cos(), th.sin());
                     let q = [c * d - s * y, s * d + c * y];
-                    (
-                        ball([0.0, 0.0], [0.0, 0.0], r),
-                        ball(q, [-speed * c, -speed * s], r),
-                    )
+                    (ball([0.0, 0.0], [0.0, 0.0], r), ball(q, [-speed * c, -speed * s], r))
                 })
                 .boxed(),
         ),
         (
             // Δv = 0 exactly, or a few ulps of one component.
             "zero/tiny relative velocity",
-            (
-                radius(),
-                angle(),
-                1.0..5.0f64,
-                float_exp(-3, 3),
-                float_exp(-3, 3),
-                -3i64..=3,
-                any::<bool>(),
-            )
+            (radius(), angle(), 1.0..5.0f64, float_exp(-3, 3), float_exp(-3, 3), -3i64..=3, any::<bool>())
                 .prop_map(|(r, th, dist, vx, vy, k, which)| {
                     let u = unit(th);
                     let v1 = [vx, vy];
-                    let v2 = if which {
-                        [nudge(vx, k), vy]
-                    } else {
-                        [vx, nudge(vy, k)]
-                    };
-                    (
-                        ball([0.0, 0.0], v1, r),
-                        ball([dist * u[0], dist * u[1]], v2, r),
-                    )
+                    let v2 = if which { [nudge(vx, k), vy] } else { [vx, nudge(vy, k)] };
+                    (ball([0.0, 0.0], v1, r), ball([dist * u[0], dist * u[1]], v2, r))
                 })
                 .boxed(),
         ),
         (
             // Parallel motion along x at different speeds, lateral offset near σ.
             "parallel offset",
-            (
-                radius(),
-                -4i64..=4,
-                1.0..1e6f64,
-                0.5..2.0f64,
-                0.5..2.0f64,
-                any::<bool>(),
-            )
+            (radius(), -4i64..=4, 1.0..1e6f64, 0.5..2.0f64, 0.5..2.0f64, any::<bool>())
                 .prop_map(|(r, k, dx, s1, s2, graze)| {
                     let sigma = 2.0 * r;
-                    let y = if graze {
-                        nudge(sigma, k)
-                    } else {
-                        sigma * (0.5 + k as f64 / 8.0)
-                    };
-                    (
-                        ball([0.0, 0.0], [s1 + s2, 0.0], r),
-                        ball([dx + sigma, y], [s1, 0.0], r),
-                    )
+                    let y = if graze { nudge(sigma, k) } else { sigma * (0.5 + k as f64 / 8.0) };
+                    (ball([0.0, 0.0], [s1 + s2, 0.0], r), ball([dx + sigma, y], [s1, 0.0], r))
                 })
                 .boxed(),
         ),
         (
             // 10⁶–10¹² apart at 10⁶–10¹² speed, aimed within 1.5σ.
             "far and fast",
-            (
-                radius(),
-                6.0..12.0f64,
-                6.0..12.0f64,
-                angle(),
-                0.0..1.5f64,
-                angle(),
-            )
+            (radius(), 6.0..12.0f64, 6.0..12.0f64, angle(), 0.0..1.5f64, angle())
                 .prop_map(|(r, ld, lv, th, bfrac, phi)| {
                     let (d, v) = (10f64.powf(ld), 10f64.powf(lv));
                     let u = unit(th);
@@ -283,25 +202,14 @@ pub fn contact_families() -> Vec<(&'static str, BoxedStrategy<Pair2>)> {
                     let q = [d * u[0] + b * n[0], d * u[1] + b * n[1]];
                     let w = unit(phi);
                     let v1 = [v * w[0] * 1e-3, v * w[1] * 1e-3];
-                    (
-                        ball([0.0, 0.0], v1, r),
-                        ball(q, [v1[0] - v * u[0], v1[1] - v * u[1]], r),
-                    )
+                    (ball([0.0, 0.0], v1, r), ball(q, [v1[0] - v * u[0], v1[1] - v * u[1]], r))
                 })
                 .boxed(),
         ),
         (
             // Overlap of 0–8 ulps; approaching, separating, or exactly tangential.
             "overlap by ulps",
-            (
-                radius(),
-                radius(),
-                0i64..=8,
-                -50.0..50.0f64,
-                -50.0..50.0f64,
-                0u8..3,
-                0.1..2.0f64,
-            )
+            (radius(), radius(), 0i64..=8, -50.0..50.0f64, -50.0..50.0f64, 0u8..3, 0.1..2.0f64)
                 .prop_map(|(r1, r2, k, x, y, mode, s)| {
                     let sigma = r1 + r2;
                     let len = (x * x + y * y).sqrt().max(1e-3);
@@ -319,24 +227,14 @@ pub fn contact_families() -> Vec<(&'static str, BoxedStrategy<Pair2>)> {
         (
             // |r| ~ 10⁶–10⁹ with R ~ 1: the neighbours' separation loses bits in r₂ − r₁.
             "large coordinates",
-            (
-                6.0..9.0f64,
-                angle(),
-                1.0..3.0f64,
-                angle(),
-                angle(),
-                0.4..0.6f64,
-            )
+            (6.0..9.0f64, angle(), 1.0..3.0f64, angle(), angle(), 0.4..0.6f64)
                 .prop_map(|(lr, th, dist, phi1, phi2, r)| {
                     let base = 10f64.powf(lr);
                     let p = [base * th.cos(), base * th.sin()];
                     let u = unit(phi1);
                     let q = [p[0] + dist * u[0], p[1] + dist * u[1]];
                     let w = unit(phi2);
-                    (
-                        ball(p, [0.0, 0.0], r),
-                        ball(q, [w[0] - u[0], w[1] - u[1]], r),
-                    )
+                    (ball(p, [0.0, 0.0], r), ball(q, [w[0] - u[0], w[1] - u[1]], r))
                 })
                 .boxed(),
         ),
@@ -374,13 +272,7 @@ pub fn contact_families() -> Vec<(&'static str, BoxedStrategy<Pair2>)> {
 /// A pair as it occurs in a dense fluid: positions in a 100σ box, separation 1–2.5σ,
 /// velocity components in [−2, 2] (the benchmark's "realistic" inputs).
 pub fn dense_pair() -> impl Strategy<Value = Pair2> {
-    (
-        0.0..100.0f64,
-        0.0..100.0f64,
-        1.0..2.5f64,
-        0.0..std::f64::consts::TAU,
-        proptest::array::uniform4(-2.0..2.0f64),
-    )
+    (0.0..100.0f64, 0.0..100.0f64, 1.0..2.5f64, 0.0..std::f64::consts::TAU, proptest::array::uniform4(-2.0..2.0f64))
         .prop_map(|(x, y, dist, th, v)| {
             let p = [x, y];
             let q = [x + dist * th.cos(), y + dist * th.sin()];
@@ -393,21 +285,12 @@ pub fn contact_families_3d() -> Vec<(&'static str, BoxedStrategy<Pair3>)> {
     vec![
         (
             "3D grazing (far)",
-            (
-                0.25..1.0f64,
-                0.0..9.0f64,
-                -4i64..=4,
-                0.5..2.0f64,
-                -10.0..10.0f64,
-            )
+            (0.25..1.0f64, 0.0..9.0f64, -4i64..=4, 0.5..2.0f64, -10.0..10.0f64)
                 .prop_map(|(r, lg, k, speed, z)| {
                     let sigma = 2.0 * r;
                     let d = sigma * 10f64.powf(lg) + 3.0 * sigma;
                     let y = nudge(sigma, k);
-                    (
-                        ball([0.0, 0.0, z], [0.0; 3], r),
-                        ball([d, y, z], [-speed, 0.0, 0.0], r),
-                    )
+                    (ball([0.0, 0.0, z], [0.0; 3], r), ball([d, y, z], [-speed, 0.0, 0.0], r))
                 })
                 .boxed(),
         ),
@@ -421,9 +304,7 @@ pub fn contact_families_3d() -> Vec<(&'static str, BoxedStrategy<Pair3>)> {
                 -8i64..=8,
             )
                 .prop_map(|(p, dir, v, r, k)| {
-                    let n = (dir[0] * dir[0] + dir[1] * dir[1] + dir[2] * dir[2])
-                        .sqrt()
-                        .max(1e-3);
+                    let n = (dir[0] * dir[0] + dir[1] * dir[1] + dir[2] * dir[2]).sqrt().max(1e-3);
                     let d = 2.0 * r * (1.0 + k as f64 * f64::EPSILON) / n;
                     let q = [p[0] + dir[0] * d, p[1] + dir[1] * d, p[2] + dir[2] * d];
                     (ball(p, [0.0; 3], r), ball(q, v, r))

@@ -18,42 +18,24 @@ pub struct Dy {
 
 impl Dy {
     pub fn zero() -> Dy {
-        Dy {
-            m: BigInt::zero(),
-            e: 0,
-        }
+        Dy { m: BigInt::zero(), e: 0 }
     }
     pub fn from_f64(x: f64) -> Dy {
         assert!(x.is_finite());
         let bits = x.to_bits();
         let biased = ((bits >> 52) & 0x7ff) as i64;
         let frac = (bits & ((1u64 << 52) - 1)) as i64;
-        let (mant, e) = if biased == 0 {
-            (frac, -1074)
-        } else {
-            (frac | (1 << 52), biased - 1075)
-        };
-        let m = if x.is_sign_negative() {
-            -BigInt::from(mant)
-        } else {
-            BigInt::from(mant)
-        };
+        let (mant, e) = if biased == 0 { (frac, -1074) } else { (frac | (1 << 52), biased - 1075) };
+        let m = if x.is_sign_negative() { -BigInt::from(mant) } else { BigInt::from(mant) };
         Dy { m, e }
     }
     /// 2^k.
     pub fn pow2(k: i64) -> Dy {
-        Dy {
-            m: BigInt::from(1),
-            e: k,
-        }
+        Dy { m: BigInt::from(1), e: k }
     }
     fn aligned(&self, o: &Dy) -> (BigInt, BigInt, i64) {
         let e = self.e.min(o.e);
-        (
-            (&self.m) << ((self.e - e) as usize),
-            (&o.m) << ((o.e - e) as usize),
-            e,
-        )
+        ((&self.m) << ((self.e - e) as usize), (&o.m) << ((o.e - e) as usize), e)
     }
     pub fn add(&self, o: &Dy) -> Dy {
         if self.m.is_zero() {
@@ -66,25 +48,16 @@ impl Dy {
         Dy { m: a + b, e }
     }
     pub fn neg(&self) -> Dy {
-        Dy {
-            m: -&self.m,
-            e: self.e,
-        }
+        Dy { m: -&self.m, e: self.e }
     }
     pub fn sub(&self, o: &Dy) -> Dy {
         self.add(&o.neg())
     }
     pub fn mul(&self, o: &Dy) -> Dy {
-        Dy {
-            m: &self.m * &o.m,
-            e: self.e + o.e,
-        }
+        Dy { m: &self.m * &o.m, e: self.e + o.e }
     }
     pub fn abs(&self) -> Dy {
-        Dy {
-            m: self.m.abs(),
-            e: self.e,
-        }
+        Dy { m: self.m.abs(), e: self.e }
     }
     /// −1, 0, 1.
     pub fn sign(&self) -> i32 {
@@ -111,10 +84,7 @@ impl Dy {
         let f = err_exp.min(self.e.div_euclid(2));
         let shifted: BigInt = (&self.m) << ((self.e - 2 * f) as usize);
         let root = shifted.magnitude().sqrt();
-        Dy {
-            m: BigInt::from(root),
-            e: f,
-        }
+        Dy { m: BigInt::from(root), e: f }
     }
     /// self / o as an f64 (relative accuracy ~2⁻⁶⁰), for o ≠ 0.
     pub fn ratio(&self, o: &Dy) -> f64 {
@@ -178,11 +148,7 @@ pub fn ulps_from_root(x: f64, p: &Dy, s: i32, disc: &Dy, q: &Dy) -> f64 {
 pub fn check_roots(a: f64, b: f64, c: f64, got: &Roots) -> RootCheck {
     let (da, db, dc) = (Dy::from_f64(a), Dy::from_f64(b), Dy::from_f64(c));
     let expected = if da.is_zero() {
-        if db.is_zero() {
-            if dc.is_zero() { usize::MAX } else { 0 }
-        } else {
-            1
-        }
+        if db.is_zero() { if dc.is_zero() { usize::MAX } else { 0 } } else { 1 }
     } else {
         let disc = db.mul(&db).sub(&Dy::from_f64(4.0).mul(&da).mul(&dc));
         match disc.sign() {
@@ -198,10 +164,7 @@ pub fn check_roots(a: f64, b: f64, c: f64, got: &Roots) -> RootCheck {
         Roots::All => usize::MAX,
     };
     if got_count != expected {
-        return RootCheck {
-            count_ok: false,
-            max_ulps: f64::NAN,
-        };
+        return RootCheck { count_ok: false, max_ulps: f64::NAN };
     }
     let mut max_ulps: f64 = 0.0;
     let mut measure = |x: f64, which: i32| {
@@ -219,11 +182,7 @@ pub fn check_roots(a: f64, b: f64, c: f64, got: &Roots) -> RootCheck {
         }
         let u = if da.is_zero() {
             // b·x + c = 0: |b·x + c| / |b·gap|
-            Dy::from_f64(x)
-                .mul(&db)
-                .add(&dc)
-                .ratio(&db.mul(&gap(x)).abs())
-                .abs()
+            Dy::from_f64(x).mul(&db).add(&dc).ratio(&db.mul(&gap(x)).abs()).abs()
         } else {
             let disc = db.mul(&db).sub(&Dy::from_f64(4.0).mul(&da).mul(&dc));
             let q = Dy::from_f64(2.0).mul(&da);
@@ -241,10 +200,7 @@ pub fn check_roots(a: f64, b: f64, c: f64, got: &Roots) -> RootCheck {
         }
         _ => {}
     }
-    RootCheck {
-        count_ok: true,
-        max_ulps,
-    }
+    RootCheck { count_ok: true, max_ulps }
 }
 
 /// A rough f64 value of root `which` (0 smaller), possibly ±∞, for overflow checks.
@@ -256,11 +212,7 @@ fn exact_root_estimate(a: &Dy, b: &Dy, c: &Dy, which: i32) -> f64 {
     let q = Dy::from_f64(2.0).mul(a);
     let root = disc.sqrt_within(disc.log2() / 2 - 80);
     let s = if which == 0 { -1 } else { 1 } * a.sign();
-    let num = if s < 0 {
-        b.neg().sub(&root)
-    } else {
-        b.neg().add(&root)
-    };
+    let num = if s < 0 { b.neg().sub(&root) } else { b.neg().add(&root) };
     num.ratio(&q)
 }
 
@@ -324,11 +276,7 @@ impl ExactContact {
         }
         if t.is_infinite() {
             let est = self.b.neg().ratio(&self.a);
-            return if est >= f64::MAX / 2.0 {
-                0.0
-            } else {
-                f64::INFINITY
-            };
+            return if est >= f64::MAX / 2.0 { 0.0 } else { f64::INFINITY };
         }
         ulps_from_root(t, &self.b.neg(), -1, &self.disc, &self.a)
     }
@@ -345,10 +293,7 @@ impl ExactContact {
 pub fn divide(n: &Dy, d: &Dy, extra: i64) -> Dy {
     let shift = (d.m.bits() as i64 + 64 + extra - n.m.bits() as i64).max(0);
     let q = ((&n.m) << (shift as usize)) / &d.m;
-    Dy {
-        m: q,
-        e: n.e - shift - d.e,
-    }
+    Dy { m: q, e: n.e - shift - d.e }
 }
 
 /// The exact real roots of a·x² + b·x + c, each correctly rounded (for the edge-case table).
@@ -368,11 +313,7 @@ pub fn roots_rounded(a: f64, b: f64, c: f64) -> Option<Vec<f64>> {
         _ => {
             // Cancellation-free: x₁ = (−b − sign(b)√Δ)/2a, x₂ = c/(a·x₁) = 2c/(−b − sign(b)√Δ).
             let root = disc.sqrt_within(disc.log2() / 2 - 300);
-            let big = if db.sign() >= 0 {
-                db.neg().sub(&root)
-            } else {
-                db.neg().add(&root)
-            };
+            let big = if db.sign() >= 0 { db.neg().sub(&root) } else { db.neg().add(&root) };
             let x1 = divide(&big, &q, 200).to_f64();
             let x2 = divide(&Dy::from_f64(2.0).mul(&dc), &big, 200).to_f64();
             Some(if x1 <= x2 { vec![x1, x2] } else { vec![x2, x1] })
