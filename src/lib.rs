@@ -44,5 +44,6 @@
 
 pub mod engine;
 pub mod io;
+pub mod observe;
 
 pub use quadratic;

@@ -1,6 +1,24 @@
-//! The collision engine. Today: the velocity update of a colliding pair; the event loop,
-//! cells, boundaries and the `Simulation` that owns them grow here (see ARCHITECTURE.md).
+//! The collision engine: particles in a box, events predicted (pure) and resolved (mutating),
+//! one [`Simulation`] that owns them all, and a brute-force [`ReferenceSimulation`] to check
+//! it against.
+//!
+//! * [`geometry`]: [`Particle`], [`SimBox`], [`Boundary`], minimum image.
+//! * [`collision`]: the velocity update and the [`Impulse`] it reports.
+//! * [`events`]: event types, their total order, the pure predictions.
+//! * [`cells`]: the cell grid.
+//! * [`simulation`]: the event loop.
+//! * [`reference`]: the O(N²) reference.
+//! * [`init`]: initial states (lattices, random placement, Maxwell or fixed-speed velocities).
 
+pub mod cells;
 pub mod collision;
+pub mod events;
+pub mod geometry;
+pub mod init;
+pub mod reference;
+pub mod simulation;
 
 pub use collision::{Body, Impulse, Restitution, RestitutionError, resolve_pair};
+pub use geometry::{Boundary, Particle, SimBox};
+pub use reference::ReferenceSimulation;
+pub use simulation::{EventCounts, Outcome, OverlapAudit, SetupError, Simulation, SimulationState};

@@ -45,5 +45,5 @@ pub mod textbook;
 
 #[doc(hidden)]
 pub use contact::contact_time_exact_path;
-pub use contact::{Ball, Contact, ContactError, Field, Miss, contact_time};
+pub use contact::{Ball, Contact, ContactError, Field, Miss, contact_time, contact_time_unchecked};
 pub use roots::{Coefficient, Roots, SolveError, solve};

@@ -1,0 +1,195 @@
+//! Events, their total order, and the pure predictions (`predict_*`) shared by the fast
+//! engine and the brute-force reference.
+//!
+//! Every prediction is a pure function of the states involved. A pair is predicted from the
+//! later of the two particles' update times, lower index first, so the same two states
+//! always give the same event time to the last bit — whichever engine asks, and whenever.
+
+use super::geometry::{Boundary, Particle, SimBox};
+use nalgebra::SVector;
+use quadratic::{Ball, Contact, contact_time_unchecked};
+use serde::{Deserialize, Serialize};
+use std::cmp::Ordering;
+
+/// What an event is about.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+pub enum EventKind {
+    /// Particles `i < j` touch.
+    Pair {
+        /// The partner (always greater than the event's `i`).
+        j: usize,
+        /// The partner's event counter at prediction.
+        j_events: u64,
+    },
+    /// Particle `i` hits the wall at the `upper` or lower end of `axis`.
+    Wall {
+        /// The axis.
+        axis: usize,
+        /// Upper (at L) or lower (at 0) wall.
+        upper: bool,
+    },
+    /// Particle `i` leaves its cell along `axis`, `up` or down.
+    Cell {
+        /// The axis.
+        axis: usize,
+        /// Direction.
+        up: bool,
+    },
+    /// A scheduled sampling instant (no particle).
+    Sample,
+}
+
+impl EventKind {
+    fn rank(&self) -> (u8, usize, bool) {
+        match *self {
+            EventKind::Pair { j, .. } => (0, j, false),
+            EventKind::Wall { axis, upper } => (1, axis, upper),
+            EventKind::Cell { axis, up } => (2, axis, up),
+            EventKind::Sample => (3, 0, false),
+        }
+    }
+}
+
+/// A predicted event.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+pub struct Event {
+    /// When.
+    pub time: f64,
+    /// The (lower-index) particle; `usize::MAX` for samples.
+    pub i: usize,
+    /// Particle `i`'s event counter at prediction.
+    pub i_events: u64,
+    /// What.
+    pub kind: EventKind,
+}
+
+impl Event {
+    /// The total order of events: by time, then pair < wall < cell < sample, then by the
+    /// particles and axes involved. No two distinct live events compare equal, so the
+    /// sequence of events never depends on the order in which they were pushed.
+    pub fn order(&self, other: &Event) -> Ordering {
+        self.time
+            .total_cmp(&other.time)
+            .then_with(|| self.kind.rank().0.cmp(&other.kind.rank().0))
+            .then_with(|| self.i.cmp(&other.i))
+            .then_with(|| self.kind.rank().cmp(&other.kind.rank()))
+            .then_with(|| self.i_events.cmp(&other.i_events))
+    }
+}
+
+/// Min-ordered wrapper for `BinaryHeap` (a max-heap).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Queued(pub Event);
+
+impl Eq for Queued {}
+impl PartialOrd for Queued {
+    fn partial_cmp(&self, other: &Self) -> Option<Ordering> {
+        Some(self.cmp(other))
+    }
+}
+impl Ord for Queued {
+    fn cmp(&self, other: &Self) -> Ordering {
+        other.0.order(&self.0)
+    }
+}
+
+/// The positions of `i` and of the image of `j` nearest to it, at time `t`.
+pub fn pair_positions<const D: usize>(
+    pi: &Particle<D>,
+    pj: &Particle<D>,
+    sim_box: &SimBox<D>,
+    t: f64,
+) -> (SVector<f64, D>, SVector<f64, D>) {
+    let ri = pi.position_at(t);
+    let rj = pj.position_at(t);
+    let shift = sim_box.minimum_image_shift(&(rj - ri));
+    (ri, rj + shift)
+}
+
+/// Periodic axes too short for four cells of width `reach`: there a pair can be adjacent
+/// through two images at once, so predictions try the images on either side of the nearest.
+pub fn short_axes<const D: usize>(sim_box: &SimBox<D>, reach: f64) -> [bool; D] {
+    let mut short = [false; D];
+    for a in 0..D {
+        short[a] = sim_box.boundary[a] == Boundary::Periodic && sim_box.lengths[a] < 4.0 * reach * (1.0 + 1e-9);
+    }
+    short
+}
+
+/// When particles `pi`, `pj` (`i < j`) next touch while approaching, as an absolute time.
+///
+/// The image of `j` is the one nearest to `i` at the current time `now` (and, along
+/// `short` axes, the images one box length to either side, the earliest contact winning);
+/// the contact itself is computed from the later of the two update times, so for a given
+/// image the answer is a pure function of the two states.
+pub fn predict_pair<const D: usize>(
+    pi: &Particle<D>,
+    pj: &Particle<D>,
+    sim_box: &SimBox<D>,
+    now: f64,
+    short: &[bool; D],
+) -> Option<f64> {
+    // Image counts (integers); a shift is always formed as one product count·L, so the same
+    // image gives the same bits however it was reached.
+    let base = sim_box.minimum_image_count(&(pj.position_at(now) - pi.position_at(now)));
+    let t0 = pi.time.max(pj.time);
+    let (ri, rj) = (pi.position_at(t0), pj.position_at(t0));
+    let a = Ball { position: ri.into(), velocity: pi.velocity.into(), radius: pi.radius };
+    let earliest = |shift: &SVector<f64, D>| {
+        let b = Ball { position: (rj + shift).into(), velocity: pj.velocity.into(), radius: pj.radius };
+        match contact_time_unchecked(&a, &b) {
+            Contact::Never(_) => None,
+            Contact::Now => Some(t0),
+            Contact::At(dt) => Some(t0 + dt),
+        }
+    };
+    if !short.iter().any(|&s| s) {
+        return earliest(&base.component_mul(&sim_box.lengths));
+    }
+    // Every combination of −1, 0, +1 box lengths along the short axes.
+    let mut best: Option<f64> = None;
+    let mut offset = [0i32; D];
+    for a in 0..D {
+        if short[a] {
+            offset[a] = -1;
+        }
+    }
+    loop {
+        let mut shift = SVector::zeros();
+        for a in 0..D {
+            shift[a] = (base[a] + offset[a] as f64) * sim_box.lengths[a];
+        }
+        if let Some(t) = earliest(&shift) {
+            best = Some(best.map_or(t, |b: f64| b.min(t)));
+        }
+        let mut a = 0;
+        while a < D && (!short[a] || offset[a] == 1) {
+            if short[a] {
+                offset[a] = -1;
+            }
+            a += 1;
+        }
+        if a == D {
+            return best;
+        }
+        offset[a] += 1;
+    }
+}
+
+/// The first wall particle `p` hits: `(time, axis, upper)`. A particle already touching or
+/// beyond a wall (by round-off) and moving into it hits it now.
+pub fn predict_wall<const D: usize>(p: &Particle<D>, sim_box: &SimBox<D>) -> Option<(f64, usize, bool)> {
+    let mut best: Option<(f64, usize, bool)> = None;
+    for a in 0..D {
+        if sim_box.boundary[a] != Boundary::Wall || p.velocity[a] == 0.0 {
+            continue;
+        }
+        let upper = p.velocity[a] > 0.0;
+        let contact = if upper { sim_box.lengths[a] - p.radius } else { p.radius };
+        let dt = ((contact - p.position[a]) / p.velocity[a]).max(0.0);
+        if best.is_none_or(|(b, _, _)| dt < b) {
+            best = Some((dt, a, upper));
+        }
+    }
+    best.map(|(dt, a, upper)| (p.time + dt, a, upper))
+}

@@ -1,0 +1,130 @@
+//! The engine against analytic two-body cases and against the brute-force reference.
+
+use collide::engine::init::{Placement, Species, Velocities, box_for_packing_fraction, initial_particles};
+use collide::engine::{Boundary, Outcome, Particle, ReferenceSimulation, SimBox, Simulation};
+use nalgebra::Vector2;
+
+fn disk(x: f64, y: f64, vx: f64, vy: f64, radius: f64, mass: f64) -> Particle<2> {
+    Particle {
+        position: Vector2::new(x, y),
+        velocity: Vector2::new(vx, vy),
+        time: 0.0,
+        radius,
+        mass,
+        species: 0,
+        events: 0,
+    }
+}
+
+fn square_box(l: f64, b: Boundary) -> SimBox<2> {
+    SimBox { lengths: Vector2::new(l, l), boundary: [b, b] }
+}
+
+/// The next pair collision (skipping cell crossings).
+fn next_pair(sim: &mut Simulation<2>) -> (usize, usize) {
+    loop {
+        match sim.step().expect("an event") {
+            Outcome::Pair { i, j, .. } => return (i, j),
+            Outcome::Cell => continue,
+            other => panic!("unexpected {other:?}"),
+        }
+    }
+}
+
+#[test]
+fn head_on_equal_masses_exchange_velocities_at_the_known_time() {
+    // Gap 2 − 1 = 1 closed at relative speed 1.5: t = 2/3.
+    let p = vec![disk(10.0, 10.0, 1.0, 0.0, 0.5, 1.0), disk(12.0, 10.0, -0.5, 0.0, 0.5, 1.0)];
+    let mut sim = Simulation::new(p, square_box(40.0, Boundary::Periodic)).unwrap();
+    assert_eq!(next_pair(&mut sim), (0, 1));
+    assert_eq!(sim.time(), 2.0 / 3.0);
+    assert_eq!(sim.particles()[0].velocity, Vector2::new(-0.5, 0.0));
+    assert_eq!(sim.particles()[1].velocity, Vector2::new(1.0, 0.0));
+}
+
+#[test]
+fn unequal_masses_and_oblique_impact_conserve_momentum_and_energy() {
+    let p = vec![disk(10.0, 10.0, 1.0, 0.2, 0.5, 3.0), disk(11.5, 10.6, -0.5, 0.0, 0.7, 1.0)];
+    let mut sim = Simulation::new(p, square_box(40.0, Boundary::Periodic)).unwrap();
+    let (p0, k0) = (sim.momentum(), sim.kinetic_energy());
+    next_pair(&mut sim);
+    let (p1, k1) = (sim.momentum(), sim.kinetic_energy());
+    // One collision: a few roundings of O(1) quantities.
+    assert!((p1 - p0).norm() <= 8.0 * f64::EPSILON * 4.0, "{p0} → {p1}");
+    assert!((k1 - k0).abs() <= 16.0 * f64::EPSILON * k0, "{k0} → {k1}");
+    // The contact is at distance R₁ + R₂ = 1.2.
+    let q = sim.particles();
+    let d = q[1].position_at(sim.time()) - q[0].position_at(sim.time());
+    assert!((d.norm() - 1.2).abs() <= 1e-14, "{}", d.norm());
+}
+
+#[test]
+fn wall_bounce_reverses_the_normal_velocity_with_impulse_2mv() {
+    let p = vec![disk(5.0, 5.0, -2.0, 1.0, 0.5, 1.5)];
+    let mut sim = Simulation::new(p, square_box(10.0, Boundary::Wall)).unwrap();
+    loop {
+        match sim.step().unwrap() {
+            Outcome::Wall { i, axis, upper, impulse } => {
+                assert_eq!((i, axis, upper, impulse), (0, 0, false, 2.0 * 1.5 * 2.0));
+                break;
+            }
+            Outcome::Cell => {}
+            other => panic!("unexpected {other:?}"),
+        }
+    }
+    assert_eq!(sim.time(), 4.5 / 2.0); // from x = 5 to x = R = 0.5 at speed 2
+    assert_eq!(sim.particles()[0].velocity, Vector2::new(2.0, 1.0));
+}
+
+fn random_system(
+    n: usize,
+    eta: f64,
+    boundary: [Boundary; 2],
+    seed: u64,
+    mixture: bool,
+) -> (Vec<Particle<2>>, SimBox<2>) {
+    let species = if mixture {
+        vec![Species { count: n / 2, radius: 0.5, mass: 1.0 }, Species { count: n - n / 2, radius: 0.35, mass: 0.4 }]
+    } else {
+        vec![Species { count: n, radius: 0.5, mass: 1.0 }]
+    };
+    let placement = Placement::Random;
+    let sim_box = box_for_packing_fraction(&species, eta, boundary, placement, 1.0);
+    let particles = initial_particles(&species, &sim_box, placement, Velocities::Maxwell, 1.0, seed).unwrap();
+    (particles, sim_box)
+}
+
+/// The fast engine (queue, cells, invalidation) and the O(N²) reference produce the same
+/// collisions — same pairs, same times to the last bit — on small systems of every kind.
+#[test]
+fn fast_engine_matches_the_brute_force_reference_bit_for_bit() {
+    let cases = [
+        ([Boundary::Periodic, Boundary::Periodic], false),
+        ([Boundary::Wall, Boundary::Wall], false),
+        ([Boundary::Periodic, Boundary::Wall], true),
+        ([Boundary::Periodic, Boundary::Periodic], true),
+    ];
+    for (case, &(boundary, mixture)) in cases.iter().enumerate() {
+        for seed in 0..3 {
+            let n = 6 + 5 * seed as usize;
+            let (particles, sim_box) = random_system(n, 0.3, boundary, 100 + seed, mixture);
+            let mut fast = Simulation::new(particles.clone(), sim_box).unwrap();
+            let mut slow = ReferenceSimulation::new(particles, sim_box);
+            for k in 0..3000 {
+                let expected = slow.step().expect("a collision");
+                let got = loop {
+                    match fast.step().expect("an event") {
+                        Outcome::Pair { i, j, .. } => break (fast.time(), i, j),
+                        Outcome::Wall { i, .. } => break (fast.time(), i, i),
+                        _ => continue,
+                    }
+                };
+                assert_eq!(
+                    (got.0.to_bits(), got.1, got.2),
+                    (expected.0.to_bits(), expected.1, expected.2),
+                    "case {case}, seed {seed}, collision {k}: fast {got:?}, reference {expected:?}"
+                );
+            }
+        }
+    }
+}
