@@ -45,5 +45,6 @@
 pub mod engine;
 pub mod io;
 pub mod observe;
+pub mod run;
 
 pub use quadratic;

@@ -6,7 +6,8 @@ use clap::{Args, Parser, Subcommand};
 use collide::io::numbers::{NumberFormat, format_text, parse_text};
 use collide::io::query::{DynBall, Query, answer_lines, contact_time_dyn};
 use collide::quadratic::Roots;
-use std::io::{self, BufWriter};
+use std::io::{self, BufWriter, IsTerminal};
+use std::path::PathBuf;
 use std::process::ExitCode;
 
 #[derive(Parser)]
@@ -18,6 +19,9 @@ struct Cli {
 
 #[derive(Subcommand)]
 enum Command {
+    /// Runs a simulation: `collide run [CONFIG.toml] [--out DIR]`, or `--resume CHECKPOINT`.
+    /// Without a file, runs the embedded default (see the README).
+    Run(RunArgs),
     /// Checks the numerics on this machine against the built-in edge-case reference
     /// (the default when no command is given); exits non-zero on any mismatch.
     Check,
@@ -25,6 +29,21 @@ enum Command {
     Roots(RootsArgs),
     /// Earliest contact time of two disks (or spheres): prints the time, or "never".
     ContactTime(ContactArgs),
+}
+
+#[derive(Args)]
+struct RunArgs {
+    /// The configuration (TOML). Omit it to run the embedded default.
+    config: Option<PathBuf>,
+    /// Output directory (created if needed).
+    #[arg(long, default_value = "collide-out")]
+    out: PathBuf,
+    /// Continue from a checkpoint written by an earlier run (instead of a configuration).
+    #[arg(long, conflicts_with = "config")]
+    resume: Option<PathBuf>,
+    /// Print the embedded default configuration and exit.
+    #[arg(long, conflicts_with_all = ["config", "resume"])]
+    print_default: bool,
 }
 
 #[derive(Args)]
@@ -90,6 +109,7 @@ fn main() -> ExitCode {
 fn run(cli: Cli) -> Result<ExitCode> {
     match cli.command.unwrap_or(Command::Check) {
         Command::Check => check(),
+        Command::Run(args) => run_simulation(args),
         Command::Roots(args) => roots(args),
         Command::ContactTime(args) => contact(args),
     }
@@ -181,5 +201,63 @@ fn contact(args: ContactArgs) -> Result<ExitCode> {
     };
     let t = contact_time_dyn(&first, &second).map_err(anyhow::Error::msg)?;
     println!("{}", t.map_or_else(|| "never".to_string(), |t| format_text(t, format)));
+    Ok(ExitCode::SUCCESS)
+}
+
+fn run_simulation(args: RunArgs) -> Result<ExitCode> {
+    use collide::io::config::{Config, DEFAULT_CONFIG};
+    use collide::io::output::{RunFailure, execute, load_checkpoint, run_config};
+    if args.print_default {
+        print!("{DEFAULT_CONFIG}");
+        return Ok(ExitCode::SUCCESS);
+    }
+    let bar = if io::stderr().is_terminal() {
+        let bar = indicatif::ProgressBar::new(1000);
+        bar.set_style(
+            indicatif::ProgressStyle::with_template("{prefix} [{bar:40}] {percent:>3}% {elapsed_precise} (eta {eta})")
+                .expect("a valid template")
+                .progress_chars("=> "),
+        );
+        bar
+    } else {
+        indicatif::ProgressBar::hidden()
+    };
+    let tick = |prefix: &'static str| {
+        let bar = bar.clone();
+        move |f: f64| {
+            bar.set_prefix(prefix);
+            bar.set_position((f * 1000.0) as u64);
+        }
+    };
+    let summary = if let Some(path) = &args.resume {
+        let checkpoint = load_checkpoint(path).map_err(anyhow::Error::msg)?;
+        let mut run = collide::run::Run::resume(checkpoint).with_context(|| path.display().to_string())?;
+        execute(&mut run, &args.out, tick("running")).context("writing results")?
+    } else {
+        let (config, source) = match &args.config {
+            Some(path) => (Config::load(path)?, path.display().to_string()),
+            None => (Config::default_config(), "the embedded default".to_string()),
+        };
+        run_config(config, &args.out, tick("equilibrating"), tick("running")).map_err(|e| match e {
+            // A bad initial state is the configuration's fault: name it.
+            RunFailure::Run(e) => anyhow::anyhow!("{source}: {e}"),
+            RunFailure::Output(e) => anyhow::anyhow!("writing results: {e}"),
+        })?
+    };
+    bar.finish_and_clear();
+    println!(
+        "{} collisions in {:.2} s ({:.3} M/s); kT = {:.6}; P = {:.6} ± {:.6}; Z = {:.5} ± {:.5}; max overlap {:.2e}; energy drift {:.2e}",
+        summary.collisions,
+        summary.wall_time_s,
+        summary.collisions_per_second / 1e6,
+        summary.kT,
+        summary.pressure_virial,
+        summary.pressure_virial_error,
+        summary.compressibility,
+        summary.compressibility_error,
+        summary.max_overlap.fraction,
+        summary.energy_relative_drift
+    );
+    println!("results in {}", args.out.display());
     Ok(ExitCode::SUCCESS)
 }
