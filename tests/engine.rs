@@ -128,3 +128,45 @@ fn fast_engine_matches_the_brute_force_reference_bit_for_bit() {
         }
     }
 }
+
+#[test]
+fn unequal_masses_head_on_follow_the_1d_formula() {
+    // Seed eq. 8 with m₁ = 3, m₂ = 1, u₁ = 1, u₂ = −1: v₁ = 0, v₂ = 2.
+    let p = vec![disk(10.0, 10.0, 1.0, 0.0, 0.5, 3.0), disk(12.0, 10.0, -1.0, 0.0, 0.5, 1.0)];
+    let mut sim = Simulation::new(p, square_box(40.0, Boundary::Periodic)).unwrap();
+    next_pair(&mut sim);
+    assert_eq!(sim.time(), 0.5);
+    assert_eq!(sim.particles()[0].velocity, Vector2::new(0.0, 0.0));
+    assert_eq!(sim.particles()[1].velocity, Vector2::new(2.0, 0.0));
+}
+
+/// Dense lattice starts (many simultaneous near-contacts, "now" events, several cells per
+/// axis) through the same comparison with the reference.
+#[test]
+fn fast_engine_matches_the_reference_from_dense_lattices() {
+    for (placement, eta, boundary) in
+        [(Placement::Triangular, 0.70, [Boundary::Periodic; 2]), (Placement::Square, 0.60, [Boundary::Wall; 2])]
+    {
+        let species = vec![Species { count: 64, radius: 0.5, mass: 1.0 }];
+        let sim_box = box_for_packing_fraction(&species, eta, boundary, placement, 1.0);
+        let particles = initial_particles(&species, &sim_box, placement, Velocities::Maxwell, 1.0, 9).unwrap();
+        let mut fast = Simulation::new(particles.clone(), sim_box).unwrap();
+        assert!(fast.cell_counts().iter().all(|&n| n >= 4), "{:?}", fast.cell_counts());
+        let mut slow = ReferenceSimulation::new(particles, sim_box);
+        for k in 0..5000 {
+            let expected = slow.step().unwrap();
+            let got = loop {
+                match fast.step().unwrap() {
+                    Outcome::Pair { i, j, .. } => break (fast.time(), i, j),
+                    Outcome::Wall { i, .. } => break (fast.time(), i, i),
+                    _ => continue,
+                }
+            };
+            assert_eq!(
+                (got.0.to_bits(), got.1, got.2),
+                (expected.0.to_bits(), expected.1, expected.2),
+                "{placement:?} collision {k}"
+            );
+        }
+    }
+}

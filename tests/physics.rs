@@ -44,6 +44,7 @@ fn energy_momentum_and_overlaps_over_a_million_collisions() {
     let (run, summary) = run_to_end(run);
     let m = summary.collisions as f64;
     let drift = ((run.sim.kinetic_energy() - k0) / k0).abs();
+    eprintln!("10⁶ collisions: |ΔK|/K = {drift:e}, max overlap {:e}", summary.max_overlap.fraction);
     assert!(drift <= 4.0 * EPS * m.sqrt(), "energy drift {drift:e} > {:e}", 4.0 * EPS * m.sqrt());
     let scale: f64 = run.sim.particles().iter().map(|p| p.mass * p.velocity.norm()).sum();
     let dp = (run.sim.momentum() - p0).norm();
@@ -128,6 +129,10 @@ fn walled_box_virial_identity() {
         })
         .collect();
     let (mean, error) = block_error(&diffs, 20);
+    eprintln!(
+        "walled box: P_virial = {} ± {}, wall − virial = {mean:e} ± {error:e}",
+        summary.pressure_virial, summary.pressure_virial_error
+    );
     assert!(mean.abs() <= 3.0 * error, "wall − virial = {mean} ± {error}");
     // And the two estimators are not trivially equal: both well above the ideal gas.
     let ideal =
