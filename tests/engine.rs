@@ -94,6 +94,25 @@ fn random_system(
     (particles, sim_box)
 }
 
+/// Runs both engines for `n` collisions and requires identical (time bits, i, j).
+fn assert_same_collisions(mut fast: Simulation<2>, mut slow: ReferenceSimulation<2>, n: usize, label: &str) {
+    for k in 0..n {
+        let expected = slow.step().expect("a collision");
+        let got = loop {
+            match fast.step().expect("an event") {
+                Outcome::Pair { i, j, .. } => break (fast.time(), i, j),
+                Outcome::Wall { i, .. } => break (fast.time(), i, i),
+                _ => continue,
+            }
+        };
+        assert_eq!(
+            (got.0.to_bits(), got.1, got.2),
+            (expected.0.to_bits(), expected.1, expected.2),
+            "{label}, collision {k}: fast {got:?}, reference {expected:?}"
+        );
+    }
+}
+
 /// The fast engine (queue, cells, invalidation) and the O(N²) reference produce the same
 /// collisions — same pairs, same times to the last bit — on small systems of every kind.
 #[test]
@@ -108,23 +127,9 @@ fn fast_engine_matches_the_brute_force_reference_bit_for_bit() {
         for seed in 0..3 {
             let n = 6 + 5 * seed as usize;
             let (particles, sim_box) = random_system(n, 0.3, boundary, 100 + seed, mixture);
-            let mut fast = Simulation::new(particles.clone(), sim_box).unwrap();
-            let mut slow = ReferenceSimulation::new(particles, sim_box);
-            for k in 0..3000 {
-                let expected = slow.step().expect("a collision");
-                let got = loop {
-                    match fast.step().expect("an event") {
-                        Outcome::Pair { i, j, .. } => break (fast.time(), i, j),
-                        Outcome::Wall { i, .. } => break (fast.time(), i, i),
-                        _ => continue,
-                    }
-                };
-                assert_eq!(
-                    (got.0.to_bits(), got.1, got.2),
-                    (expected.0.to_bits(), expected.1, expected.2),
-                    "case {case}, seed {seed}, collision {k}: fast {got:?}, reference {expected:?}"
-                );
-            }
+            let fast = Simulation::new(particles.clone(), sim_box).unwrap();
+            let slow = ReferenceSimulation::new(particles, sim_box);
+            assert_same_collisions(fast, slow, 3000, &format!("case {case}, seed {seed}"));
         }
     }
 }
@@ -150,23 +155,9 @@ fn fast_engine_matches_the_reference_from_dense_lattices() {
         let species = vec![Species { count: 64, radius: 0.5, mass: 1.0 }];
         let sim_box = box_for_packing_fraction(&species, eta, boundary, placement, 1.0);
         let particles = initial_particles(&species, &sim_box, placement, Velocities::Maxwell, 1.0, 9).unwrap();
-        let mut fast = Simulation::new(particles.clone(), sim_box).unwrap();
+        let fast = Simulation::new(particles.clone(), sim_box).unwrap();
         assert!(fast.cell_counts().iter().all(|&n| n >= 4), "{:?}", fast.cell_counts());
-        let mut slow = ReferenceSimulation::new(particles, sim_box);
-        for k in 0..5000 {
-            let expected = slow.step().unwrap();
-            let got = loop {
-                match fast.step().unwrap() {
-                    Outcome::Pair { i, j, .. } => break (fast.time(), i, j),
-                    Outcome::Wall { i, .. } => break (fast.time(), i, i),
-                    _ => continue,
-                }
-            };
-            assert_eq!(
-                (got.0.to_bits(), got.1, got.2),
-                (expected.0.to_bits(), expected.1, expected.2),
-                "{placement:?} collision {k}"
-            );
-        }
+        let slow = ReferenceSimulation::new(particles, sim_box);
+        assert_same_collisions(fast, slow, 5000, &format!("{placement:?}"));
     }
 }

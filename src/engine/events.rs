@@ -5,6 +5,7 @@
 //! later of the two particles' update times, lower index first, so the same two states
 //! always give the same event time to the last bit — whichever engine asks, and whenever.
 
+use super::collision::{Body, Impulse, Restitution, resolve_pair};
 use super::geometry::{Boundary, Particle, SimBox};
 use nalgebra::SVector;
 use quadratic::{Ball, Contact, contact_time_unchecked};
@@ -192,4 +193,44 @@ pub fn predict_wall<const D: usize>(p: &Particle<D>, sim_box: &SimBox<D>) -> Opt
         }
     }
     best.map(|(dt, a, upper)| (p.time + dt, a, upper))
+}
+
+/// Resolves the collision of particles `i < j` at time `t`: both are advanced to `t`, their
+/// velocities updated along the line of centres (minimum image), their event counters
+/// incremented. Returns the impulse on `j` and the contact vector.
+pub fn resolve_pair_event<const D: usize>(
+    particles: &mut [Particle<D>],
+    i: usize,
+    j: usize,
+    sim_box: &SimBox<D>,
+    t: f64,
+    restitution: Restitution,
+) -> Impulse<D> {
+    particles[i].advance(t);
+    particles[j].advance(t);
+    let (ri, rj) = pair_positions(&particles[i], &particles[j], sim_box, t);
+    let (pi, pj) = (&particles[i], &particles[j]);
+    let mut a = Body { position: ri, velocity: pi.velocity, mass: pi.mass };
+    let mut b = Body { position: rj, velocity: pj.velocity, mass: pj.mass };
+    let impulse = resolve_pair(&mut a, &mut b, restitution);
+    for (k, body) in [(i, a), (j, b)] {
+        particles[k].velocity = body.velocity;
+        particles[k].events += 1;
+    }
+    impulse
+}
+
+/// Resolves particle `p` hitting the `upper` or lower wall of `axis` at time `t`: advanced,
+/// the normal velocity reversed if it moves into the wall, the counter incremented. Returns
+/// the impulse |Δp| = 2m|v⊥| (0 if it was not moving into the wall).
+pub fn resolve_wall_event<const D: usize>(p: &mut Particle<D>, axis: usize, upper: bool, t: f64) -> f64 {
+    p.advance(t);
+    let v = p.velocity[axis];
+    p.events += 1;
+    if v != 0.0 && (v > 0.0) == upper {
+        p.velocity[axis] = -v;
+        2.0 * p.mass * v.abs()
+    } else {
+        0.0
+    }
 }

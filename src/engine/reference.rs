@@ -9,8 +9,8 @@
 //! `(L/2 − reach)/(2·v_max)` — less than the time any pair needs to switch image and then
 //! touch — and predicts again from there when nothing happens sooner.
 
-use super::collision::{Body, Restitution, resolve_pair};
-use super::events::{Event, EventKind, pair_positions, predict_pair, predict_wall, short_axes};
+use super::collision::Restitution;
+use super::events::{Event, EventKind, predict_pair, predict_wall, resolve_pair_event, resolve_wall_event, short_axes};
 use super::geometry::Boundary;
 use super::geometry::{Particle, SimBox};
 
@@ -99,25 +99,11 @@ impl<const D: usize> ReferenceSimulation<D> {
         let t = e.time;
         match e.kind {
             EventKind::Pair { j, .. } => {
-                let i = e.i;
-                self.particles[i].advance(t);
-                self.particles[j].advance(t);
-                let (ri, rj) = pair_positions(&self.particles[i], &self.particles[j], &self.sim_box, t);
-                let (pi, pj) = (&self.particles[i], &self.particles[j]);
-                let mut a = Body { position: ri, velocity: pi.velocity, mass: pi.mass };
-                let mut b = Body { position: rj, velocity: pj.velocity, mass: pj.mass };
-                resolve_pair(&mut a, &mut b, Restitution::ELASTIC);
-                self.particles[i].velocity = a.velocity;
-                self.particles[j].velocity = b.velocity;
-                self.particles[i].events += 1;
-                self.particles[j].events += 1;
-                (t, i, j)
+                resolve_pair_event(&mut self.particles, e.i, j, &self.sim_box, t, Restitution::ELASTIC);
+                (t, e.i, j)
             }
-            EventKind::Wall { axis, .. } => {
-                let p = &mut self.particles[e.i];
-                p.advance(t);
-                p.velocity[axis] = -p.velocity[axis];
-                p.events += 1;
+            EventKind::Wall { axis, upper } => {
+                resolve_wall_event(&mut self.particles[e.i], axis, upper, t);
                 (t, e.i, e.i)
             }
             EventKind::Cell { .. } | EventKind::Sample => unreachable!("the reference predicts only collisions"),

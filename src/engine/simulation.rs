@@ -7,8 +7,11 @@
 //! returns an [`Outcome`] describing what happened, for the observers.
 
 use super::cells::Cells;
-use super::collision::{Body, Impulse, Restitution, resolve_pair};
-use super::events::{Event, EventKind, Queued, pair_positions, predict_pair, predict_wall, short_axes};
+use super::collision::{Impulse, Restitution};
+use super::events::{
+    Event, EventKind, Queued, pair_positions, predict_pair, predict_wall, resolve_pair_event, resolve_wall_event,
+    short_axes,
+};
 use super::geometry::{Boundary, Particle, SimBox};
 use nalgebra::SVector;
 use serde::{Deserialize, Serialize};
@@ -435,34 +438,14 @@ impl<const D: usize> Simulation<D> {
             EventKind::Pair { j, .. } => {
                 self.counts.pair += 1;
                 let i = e.i;
-                self.particles[i].advance(t);
-                self.particles[j].advance(t);
-                let (ri, rj) = pair_positions(&self.particles[i], &self.particles[j], &self.sim_box, t);
-                let (pi, pj) = (&self.particles[i], &self.particles[j]);
-                let mut a = Body { position: ri, velocity: pi.velocity, mass: pi.mass };
-                let mut b = Body { position: rj, velocity: pj.velocity, mass: pj.mass };
-                let impulse = resolve_pair(&mut a, &mut b, self.restitution);
-                self.particles[i].velocity = a.velocity;
-                self.particles[j].velocity = b.velocity;
-                self.particles[i].events += 1;
-                self.particles[j].events += 1;
+                let impulse = resolve_pair_event(&mut self.particles, i, j, &self.sim_box, t, self.restitution);
                 self.predict(i, Some(j));
                 self.predict(j, None);
                 Outcome::Pair { i, j, impulse }
             }
             EventKind::Wall { axis, upper } => {
                 self.counts.wall += 1;
-                let p = &mut self.particles[e.i];
-                p.advance(t);
-                let v = p.velocity[axis];
-                // Only a particle moving into the wall bounces (a stale-free event always is).
-                let impulse = if (v > 0.0) == upper && v != 0.0 {
-                    p.velocity[axis] = -v;
-                    2.0 * p.mass * v.abs()
-                } else {
-                    0.0
-                };
-                p.events += 1;
+                let impulse = resolve_wall_event(&mut self.particles[e.i], axis, upper, t);
                 self.predict(e.i, None);
                 Outcome::Wall { i: e.i, axis, upper, impulse }
             }
