@@ -44,6 +44,7 @@
 
 pub mod engine;
 pub mod io;
+pub mod lab;
 pub mod observe;
 pub mod run;
 
