@@ -94,3 +94,52 @@ fn maxwell_boltzmann_checks_can_fail() {
     let v = verdicts_from(&good, &equal, 1.0);
     assert!(v.iter().all(|&p| !p), "{v:?}");
 }
+
+#[test]
+fn equation_of_state_quick_passes_and_writes_points() {
+    use collide::lab::equation_of_state;
+    let dir = out("lab-eos");
+    let result = equation_of_state::run(&Options { quick: true, seed: 1, out: dir.clone() }).unwrap();
+    result.write(&dir).unwrap();
+    assert!(result.passed(), "{}", collide::lab::check::table("equation_of_state", &result.checks));
+    assert!(result.checks.len() >= 3);
+    let json: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(dir.join("equation_of_state/result.json")).unwrap()).unwrap();
+    let points = json["data"]["points"].as_array().unwrap();
+    assert_eq!(points.len(), 4);
+    for p in points {
+        for key in ["eta", "Z", "Z_err", "n_particles", "collisions"] {
+            assert!(p.get(key).is_some(), "a point lacks {key}");
+        }
+    }
+    assert_svgs(&result, &dir);
+}
+
+/// The reference equations of state at known points, and checks failing for a pressure
+/// that is off (a factor 1.05, or an ideal gas where the fluid is dense).
+#[test]
+fn equation_of_state_references_and_checks_can_fail() {
+    use collide::lab::equation_of_state::{Point, check_point, z_henderson, z_slhy, z_virial};
+    assert_eq!(z_henderson(0.5), 4.125);
+    // SLHY at η = 0.5: 1/(2η_cp−1)η²/η_cp²) with 1 − 2η = 0.
+    assert!(
+        (z_slhy(0.5) - 1.0 / (0.25 * (2.0 * 0.906_899_682_117_108_9 - 1.0) / 0.906_899_682_117_108_9f64.powi(2))).abs()
+            < 1e-12
+    );
+    assert!((z_virial(0.1) - 1.236_144).abs() < 1e-6, "{}", z_virial(0.1));
+    let point = |eta: f64, z: f64| Point {
+        eta,
+        z,
+        z_err: 0.004,
+        n_particles: 1024,
+        collisions: 1_000_000,
+        equilibration_per_particle: 500.0,
+    };
+    for eta in [0.1, 0.3, 0.45] {
+        let truth = if eta <= 0.2 { z_virial(eta) } else { z_henderson(eta) };
+        assert!(check_point(&point(eta, truth)).unwrap().pass);
+        assert!(!check_point(&point(eta, 1.05 * truth)).unwrap().pass, "η = {eta}: 5 % off must fail");
+        assert!(!check_point(&point(eta, 1.0)).unwrap().pass, "η = {eta}: an ideal gas must fail");
+    }
+    assert!(check_point(&point(0.65, 8.0)).is_none(), "no check above η = 0.5");
+}

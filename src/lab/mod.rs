@@ -6,6 +6,7 @@
 //! (`cargo run --release --bin <name>`) through [`main_for`].
 
 pub mod check;
+pub mod equation_of_state;
 pub mod maxwell_boltzmann;
 pub mod plot;
 pub mod stats;
