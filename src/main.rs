@@ -22,13 +22,35 @@ enum Command {
     /// Runs a simulation: `collide run [CONFIG.toml] [--out DIR]`, or `--resume CHECKPOINT`.
     /// Without a file, runs the embedded default (see the README).
     Run(RunArgs),
-    /// Checks the numerics on this machine against the built-in edge-case reference
-    /// (the default when no command is given); exits non-zero on any mismatch.
+    /// Runs every physics experiment and writes a validation report (`index.html`,
+    /// `report.md`); the default when no command is given. Exits non-zero if a check fails.
+    Validate(ValidateArgs),
+    /// Checks the numerics on this machine against the built-in edge-case reference;
+    /// exits non-zero on any mismatch.
     Check,
     /// Real roots of a·x² + b·x + c = 0: prints them ascending on one line, "none", or "all".
     Roots(RootsArgs),
     /// Earliest contact time of two disks (or spheres): prints the time, or "never".
     ContactTime(ContactArgs),
+}
+
+#[derive(Args)]
+struct ValidateArgs {
+    /// CI-sized experiments (seconds) instead of report quality (about a minute).
+    #[arg(long)]
+    quick: bool,
+    /// Seed of the initial states.
+    #[arg(long, default_value_t = 1)]
+    seed: u64,
+    /// Output directory for the report and each experiment's results.
+    #[arg(long, default_value = "validation")]
+    out: PathBuf,
+}
+
+impl Default for ValidateArgs {
+    fn default() -> Self {
+        ValidateArgs { quick: false, seed: 1, out: PathBuf::from("validation") }
+    }
 }
 
 #[derive(Args)]
@@ -107,7 +129,8 @@ fn main() -> ExitCode {
 }
 
 fn run(cli: Cli) -> Result<ExitCode> {
-    match cli.command.unwrap_or(Command::Check) {
+    match cli.command.unwrap_or(Command::Validate(ValidateArgs::default())) {
+        Command::Validate(args) => validate(args),
         Command::Check => check(),
         Command::Run(args) => run_simulation(args),
         Command::Roots(args) => roots(args),
@@ -260,4 +283,22 @@ fn run_simulation(args: RunArgs) -> Result<ExitCode> {
     );
     println!("results in {}", args.out.display());
     Ok(ExitCode::SUCCESS)
+}
+
+fn validate(args: ValidateArgs) -> Result<ExitCode> {
+    use collide::lab::{Options, check::table, report::validate};
+    let options = Options { quick: args.quick, seed: args.seed, out: args.out };
+    let results = validate(&options, |name| eprintln!("running {name} …")).map_err(anyhow::Error::msg)?;
+    for r in &results {
+        print!("{}", table(&r.name, &r.checks));
+    }
+    let failed: Vec<&str> = results.iter().filter(|r| !r.passed()).map(|r| r.name.as_str()).collect();
+    println!("report: {}", options.out.join("index.html").display());
+    if failed.is_empty() {
+        println!("all checks pass");
+        Ok(ExitCode::SUCCESS)
+    } else {
+        eprintln!("collide: checks fail in {}", failed.join(", "));
+        Ok(ExitCode::FAILURE)
+    }
 }

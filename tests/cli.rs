@@ -82,8 +82,8 @@ fn jsonl_answers_every_good_line_and_fails_at_the_end_for_bad_ones() {
 }
 
 #[test]
-fn bare_collide_runs_the_reference_check() {
-    let out = collide(&[], "");
+fn check_verifies_the_reference_cases() {
+    let out = collide(&["check"], "");
     assert!(out.status.success(), "{}", text(&out.stderr));
     let stdout = text(&out.stdout);
     assert!(stdout.contains("agree with the exact answers"), "{stdout}");

@@ -143,3 +143,24 @@ fn equation_of_state_references_and_checks_can_fail() {
     }
     assert!(check_point(&point(0.65, 8.0)).is_none(), "no check above η = 0.5");
 }
+
+/// `collide validate --quick`: every experiment, one self-contained HTML page and a Markdown
+/// report with the verdicts, the machine, the version and the seed; exit status 0.
+#[test]
+fn validate_writes_the_report() {
+    let dir = out("lab-validate");
+    let result = std::process::Command::new(env!("CARGO_BIN_EXE_collide"))
+        .args(["validate", "--quick", "--seed", "3", "--out", dir.to_str().unwrap()])
+        .output()
+        .unwrap();
+    assert!(result.status.success(), "{}", String::from_utf8_lossy(&result.stderr));
+    let html = std::fs::read_to_string(dir.join("index.html")).unwrap();
+    let md = std::fs::read_to_string(dir.join("report.md")).unwrap();
+    for (name, _) in collide::lab::report::EXPERIMENTS {
+        assert!(html.contains(&format!("id=\"{name}\"")) && md.contains(&format!("## {name}")), "{name} missing");
+        assert!(dir.join(name).join("result.json").exists());
+    }
+    assert!(html.matches("<svg").count() >= 6, "plots are inlined");
+    assert!(md.contains("seed 3") && md.contains(env!("CARGO_PKG_VERSION")) && md.contains("cores"));
+    assert!(md.contains("ALL CHECKS PASS") && !md.contains("| FAIL |"));
+}

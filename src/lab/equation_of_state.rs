@@ -154,6 +154,7 @@ pub fn run(options: &Options) -> Result<ExperimentResult, String> {
         title: "Hard-disk equation of state".into(),
         x_label: "packing fraction η (dimensionless)".into(),
         y_label: "Z = βP/n (dimensionless)".into(),
+        legend_left: true,
         series: vec![
             Series::errors(
                 "collide (collision virial)",
@@ -170,6 +171,7 @@ pub fn run(options: &Options) -> Result<ExperimentResult, String> {
         title: "Relative residuals Z/Z_ref − 1".into(),
         x_label: "packing fraction η (dimensionless)".into(),
         y_label: "Z/Z_ref − 1 (dimensionless)".into(),
+        legend_left: true,
         series: vec![
             Series::errors(
                 "vs Henderson",

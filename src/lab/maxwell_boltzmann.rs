@@ -178,6 +178,7 @@ pub fn run(options: &Options) -> Result<ExperimentResult, String> {
                 title: "Speed distribution relaxing to the 2D Maxwellian (t = 0: all at u = √2)".into(),
                 x_label: "speed u = v/√(kT/m)".into(),
                 y_label: "probability density".into(),
+                legend_left: false,
                 series: hist_series,
             },
         ),
@@ -187,6 +188,7 @@ pub fn run(options: &Options) -> Result<ExperimentResult, String> {
                 title: "KS distance to the Rayleigh CDF".into(),
                 x_label: "t / τ (mean free times)".into(),
                 y_label: "KS distance D".into(),
+                legend_left: false,
                 series: vec![
                     Series::points("measured", series.iter().map(|m| (in_tau(m.t), m.ks)).collect()),
                     Series::line(
@@ -202,6 +204,7 @@ pub fn run(options: &Options) -> Result<ExperimentResult, String> {
                 title: "H-function relative to equilibrium".into(),
                 x_label: "t / τ (mean free times)".into(),
                 y_label: "H − H_eq (nats)".into(),
+                legend_left: false,
                 series: vec![Series::errors(
                     "bias-corrected KL divergence",
                     series.iter().map(|m| (in_tau(m.t), m.h)).collect(),
@@ -215,6 +218,7 @@ pub fn run(options: &Options) -> Result<ExperimentResult, String> {
                 title: "Sonine coefficient and kurtosis".into(),
                 x_label: "t / τ (mean free times)".into(),
                 y_label: "a₂, kurtosis − 3 (dimensionless)".into(),
+                legend_left: false,
                 series: vec![
                     Series::errors(
                         "a₂",

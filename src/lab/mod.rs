@@ -9,6 +9,7 @@ pub mod check;
 pub mod equation_of_state;
 pub mod maxwell_boltzmann;
 pub mod plot;
+pub mod report;
 pub mod stats;
 
 pub use check::Check;

@@ -52,6 +52,8 @@ pub struct Chart {
     pub y_label: String,
     /// The data.
     pub series: Vec<Series>,
+    /// Legend in the upper left corner (default: upper right).
+    pub legend_left: bool,
 }
 
 const COLOURS: [RGBColor; 6] = [
@@ -116,6 +118,7 @@ pub fn draw(chart: &Chart, path: &Path) -> Result<(), String> {
         drawn.label(s.label.as_str()).legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], style));
     }
     plot.configure_series_labels()
+        .position(if chart.legend_left { SeriesLabelPosition::UpperLeft } else { SeriesLabelPosition::UpperRight })
         .background_style(WHITE.mix(0.85))
         .border_style(BLACK)
         .label_font(("sans-serif", 14))

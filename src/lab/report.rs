@@ -1,0 +1,160 @@
+//! `collide validate`: every experiment, then one report (`index.html`, `report.md`) with
+//! the verdict table, each check against its expectation and tolerance, the plots, the
+//! machine, the version and the seed.
+
+use super::{Check, Experiment, ExperimentResult, Options, equation_of_state, maxwell_boltzmann};
+use crate::io::output::write_atomic;
+use std::fmt::Write as _;
+
+/// Every experiment, in report order.
+pub const EXPERIMENTS: &[(&str, Experiment)] =
+    &[(maxwell_boltzmann::NAME, maxwell_boltzmann::run), (equation_of_state::NAME, equation_of_state::run)];
+
+/// The numerics self-check (the edge-case reference) as an experiment-like result.
+pub fn numerics(options: &Options) -> ExperimentResult {
+    let report = quadratic::reference::check_all();
+    ExperimentResult {
+        name: "numerics".into(),
+        quick: options.quick,
+        seed: options.seed,
+        parameters: serde_json::json!({ "cases": report.cases }),
+        data: serde_json::json!({ "report": report.text }),
+        checks: vec![Check::within(
+            "edge-case reference cases disagreeing with the exact answers",
+            report.failures as f64,
+            0.0,
+            0.0,
+            0.0,
+            "exact: the stored answers are proved by the big-integer oracle",
+        )],
+        plots: Vec::new(),
+    }
+}
+
+/// A description of this machine: OS, architecture, CPU model, cores.
+pub fn machine() -> String {
+    let cpu = std::fs::read_to_string("/proc/cpuinfo")
+        .ok()
+        .and_then(|s| {
+            s.lines()
+                .find(|l| l.starts_with("model name"))
+                .map(|l| l.split(':').nth(1).unwrap_or("").trim().to_string())
+        })
+        .unwrap_or_else(|| "unknown CPU".into());
+    let cores = std::thread::available_parallelism().map(|n| n.get()).unwrap_or(1);
+    format!("{} {}, {cpu}, {cores} cores", std::env::consts::OS, std::env::consts::ARCH)
+}
+
+fn escape(s: &str) -> String {
+    s.replace('&', "&amp;").replace('<', "&lt;").replace('>', "&gt;")
+}
+
+fn expectation(c: &Check) -> String {
+    if c.kind == "within" {
+        format!("{:.6} ± {:.3e}", c.expected, c.tolerance)
+    } else {
+        format!("≤ {:.6}", c.expected)
+    }
+}
+
+/// Writes `report.md` and `index.html` for these results into `options.out`.
+pub fn write_report(results: &[ExperimentResult], options: &Options) -> Result<(), String> {
+    let passed = results.iter().all(ExperimentResult::passed);
+    let header = format!(
+        "collide {} · {} · seed {} · {} · {}",
+        env!("CARGO_PKG_VERSION"),
+        if options.quick { "quick" } else { "report size" },
+        options.seed,
+        machine(),
+        if passed { "ALL CHECKS PASS" } else { "SOME CHECKS FAIL" }
+    );
+    let mut md =
+        format!("# collide validation report\n\n{header}\n\n| experiment | checks | verdict |\n|---|---|---|\n");
+    for r in results {
+        let ok = r.checks.iter().filter(|c| c.pass).count();
+        writeln!(md, "| {} | {ok}/{} | {} |", r.name, r.checks.len(), if r.passed() { "PASS" } else { "FAIL" })
+            .unwrap();
+    }
+    let mut html = format!(
+        "<!doctype html><html><head><meta charset=\"utf-8\"><title>collide validation</title>\
+         <style>body{{font-family:sans-serif;max-width:1100px;margin:auto}}td,th{{padding:3px 8px;border-bottom:1px solid #ddd}}\
+         .pass{{color:#176b1a}}.fail{{color:#b00020;font-weight:bold}}svg{{max-width:100%;height:auto}}</style></head><body>\
+         <h1>collide validation report</h1><p>{}</p><table><tr><th>experiment</th><th>checks</th><th>verdict</th></tr>",
+        escape(&header)
+    );
+    for r in results {
+        let ok = r.checks.iter().filter(|c| c.pass).count();
+        let (class, verdict) = if r.passed() { ("pass", "PASS") } else { ("fail", "FAIL") };
+        write!(
+            html,
+            "<tr><td><a href=\"#{0}\">{0}</a></td><td>{ok}/{1}</td><td class=\"{class}\">{verdict}</td></tr>",
+            r.name,
+            r.checks.len()
+        )
+        .unwrap();
+    }
+    html.push_str("</table>");
+    for r in results {
+        writeln!(md, "\n## {}\n\n| check | measured | error | expected | verdict | why this tolerance |\n|---|---|---|---|---|---|", r.name)
+            .unwrap();
+        write!(
+            html,
+            "<h2 id=\"{0}\">{0}</h2><table><tr><th>check</th><th>measured</th><th>error</th><th>expected</th><th>verdict</th><th>why this tolerance</th></tr>",
+            r.name
+        )
+        .unwrap();
+        for c in &r.checks {
+            let verdict = if c.pass { "PASS" } else { "FAIL" };
+            writeln!(
+                md,
+                "| {} | {:.6} | {:.2e} | {} | {verdict} | {} |",
+                c.name,
+                c.measured,
+                c.error,
+                expectation(c),
+                c.why
+            )
+            .unwrap();
+            write!(
+                html,
+                "<tr><td>{}</td><td>{:.6}</td><td>{:.2e}</td><td>{}</td><td class=\"{}\">{verdict}</td><td>{}</td></tr>",
+                escape(&c.name),
+                c.measured,
+                c.error,
+                escape(&expectation(c)),
+                verdict.to_lowercase(),
+                escape(&c.why)
+            )
+            .unwrap();
+        }
+        html.push_str("</table>");
+        for plot in &r.plots {
+            writeln!(md, "\n![{plot}]({}/{plot})", r.name).unwrap();
+            let path = ExperimentResult::dir(&options.out, &r.name).join(plot);
+            let svg = std::fs::read_to_string(&path).map_err(|e| format!("{}: {e}", path.display()))?;
+            // Inline: the page is self-contained.
+            write!(html, "<figure>{}</figure>", svg.trim_start_matches("<?xml version=\"1.0\" encoding=\"UTF-8\"?>"))
+                .unwrap();
+        }
+    }
+    html.push_str("</body></html>\n");
+    let out = &options.out;
+    std::fs::create_dir_all(out).map_err(|e| format!("{}: {e}", out.display()))?;
+    write_atomic(&out.join("report.md"), md.as_bytes()).map_err(|e| e.to_string())?;
+    write_atomic(&out.join("index.html"), html.as_bytes()).map_err(|e| e.to_string())?;
+    Ok(())
+}
+
+/// Runs the numerics check and every experiment, writes their results and the report, and
+/// returns the results (`progress` hears each experiment's name as it starts).
+pub fn validate(options: &Options, mut progress: impl FnMut(&str)) -> Result<Vec<ExperimentResult>, String> {
+    let mut results = vec![numerics(options)];
+    for (name, experiment) in EXPERIMENTS {
+        progress(name);
+        let result = experiment(options)?;
+        result.write(&options.out).map_err(|e| e.to_string())?;
+        results.push(result);
+    }
+    write_report(&results, options)?;
+    Ok(results)
+}
