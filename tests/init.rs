@@ -53,3 +53,16 @@ fn the_same_seed_gives_the_same_state() {
     let b = build(200, 0.4, Placement::Random, Velocities::Maxwell, [Boundary::Periodic; 2]);
     assert_eq!(a.particles(), b.particles());
 }
+
+/// Lattice sites between walls never round past the accessible region (a 1-ulp excess
+/// would be rejected as "outside the walls").
+#[test]
+fn walled_lattices_stay_inside_at_many_sizes() {
+    for n in [100, 400, 1000, 1600, 2500] {
+        for eta in [0.05, 0.1, 0.2, 0.4, 0.6] {
+            for placement in [Placement::Square, Placement::Triangular] {
+                build(n, eta, placement, Velocities::Maxwell, [Boundary::Wall; 2]);
+            }
+        }
+    }
+}

@@ -164,3 +164,91 @@ fn validate_writes_the_report() {
     assert!(md.contains("seed 3") && md.contains(env!("CARGO_PKG_VERSION")) && md.contains("cores"));
     assert!(md.contains("ALL CHECKS PASS") && !md.contains("| FAIL |"));
 }
+
+#[test]
+fn wall_pressure_quick_passes() {
+    use collide::lab::wall_pressure;
+    let dir = out("lab-wall");
+    let result = wall_pressure::run(&Options { quick: true, seed: 1, out: dir.clone() }).unwrap();
+    result.write(&dir).unwrap();
+    assert!(result.passed(), "{}", collide::lab::check::table("wall_pressure", &result.checks));
+    assert!(result.checks.len() >= 4);
+    assert_svgs(&result, &dir);
+}
+
+#[test]
+fn wall_pressure_checks_can_fail() {
+    use collide::lab::wall_pressure::{WalledState, eos_check, identity_check};
+    let good = WalledState {
+        eta: 0.4,
+        n_particles: 1600,
+        kt: 1.0,
+        p_wall: 0.0,
+        p_wall_err: 0.004,
+        p_virial: 0.0,
+        p_virial_err: 0.004,
+        difference: 0.001,
+        difference_err: 0.003,
+        n_mid: 0.5,
+        n_mid_err: 0.0005,
+        n_accessible: 0.52,
+    };
+    let truth = good.p_eos_mid().0;
+    let state = |p: f64, diff: f64| WalledState { p_wall: p, p_virial: p - diff, difference: diff, ..good.clone() };
+    assert!(eos_check(&state(truth, 0.001)).unwrap().pass);
+    assert!(identity_check(&state(truth, 0.001)).pass);
+    // A pressure 5 % high, an ideal gas at this density, a broken identity (a wall pressure
+    // divided by the full wall length instead of the accessible one differs by σ/L ≈ 2.5 %).
+    assert!(!eos_check(&state(1.05 * truth, 0.001)).unwrap().pass);
+    assert!(!eos_check(&state(good.n_mid * good.kt, 0.001)).unwrap().pass);
+    assert!(!identity_check(&state(truth, 0.025 * truth)).pass);
+}
+
+#[test]
+fn collision_rate_and_equipartition_quick_pass() {
+    use collide::lab::{collision_rate, equipartition};
+    for (name, experiment) in [
+        (collision_rate::NAME, collision_rate::run as collide::lab::Experiment),
+        (equipartition::NAME, equipartition::run),
+    ] {
+        let dir = out(&format!("lab-{name}"));
+        let result = experiment(&Options { quick: true, seed: 1, out: dir.clone() }).unwrap();
+        result.write(&dir).unwrap();
+        assert!(result.passed(), "{}", collide::lab::check::table(name, &result.checks));
+        assert_svgs(&result, &dir);
+    }
+}
+
+#[test]
+fn collision_rate_checks_can_fail() {
+    use collide::lab::collision_rate::{RateState, checks_for, g_henderson, gamma_enskog};
+    let truth = gamma_enskog(0.4, g_henderson(0.4));
+    let state = |gamma: f64, diff: f64| RateState {
+        eta: 0.4,
+        n_particles: 1600,
+        gamma,
+        gamma_err: 0.01,
+        z: 2.83,
+        z_err: 0.003,
+        identity_difference: diff,
+        identity_difference_err: 0.01,
+        mean_free_path: 0.2,
+    };
+    assert!(checks_for(&state(truth, 0.0)).iter().all(|c| c.pass));
+    // A rate 5 % off (e.g. collisions counted once instead of for both partners would be 50 %),
+    // and an identity broken by 0.1 (a pressure 2 % off at this density).
+    assert!(!checks_for(&state(1.05 * truth, 0.0))[1].pass);
+    assert!(!checks_for(&state(0.5 * truth, 0.0))[1].pass);
+    assert!(!checks_for(&state(truth, 0.1))[0].pass);
+}
+
+/// A mixture whose species stay at different temperatures fails; one that equilibrates passes.
+#[test]
+fn equipartition_check_can_fail() {
+    use collide::lab::equipartition::relax;
+    // Too short to relax (5 mean free times from kT 2 vs 0.5): the difference is still large.
+    let (_, check) = relax([0.5, 0.5], 400, 5.0, 1, "short").unwrap();
+    assert!(!check.pass, "{check:?}");
+    let (_, check) = relax([0.5, 0.5], 400, 300.0, 1, "long").unwrap();
+    assert!(check.pass, "{check:?}");
+}

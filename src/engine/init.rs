@@ -129,7 +129,8 @@ fn lattice_coordinate(k: usize, offset: f64, count: usize, l: f64, boundary: Bou
         Boundary::Periodic => (k as f64 + offset + 0.5) * l / count as f64,
         Boundary::Wall => {
             let span = count as f64 - 1.0 + max_offset;
-            if span <= 0.0 { l / 2.0 } else { r + (k as f64 + offset) * (l - 2.0 * r) / span }
+            // Clamped: r + (n−1)·((l − 2r)/(n−1)) can round one ulp past l − r.
+            if span <= 0.0 { l / 2.0 } else { (r + (k as f64 + offset) * (l - 2.0 * r) / span).clamp(r, l - r) }
         }
     }
 }

@@ -6,11 +6,14 @@
 //! (`cargo run --release --bin <name>`) through [`main_for`].
 
 pub mod check;
+pub mod collision_rate;
 pub mod equation_of_state;
+pub mod equipartition;
 pub mod maxwell_boltzmann;
 pub mod plot;
 pub mod report;
 pub mod stats;
+pub mod wall_pressure;
 
 pub use check::Check;
 

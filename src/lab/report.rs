@@ -2,13 +2,21 @@
 //! the verdict table, each check against its expectation and tolerance, the plots, the
 //! machine, the version and the seed.
 
-use super::{Check, Experiment, ExperimentResult, Options, equation_of_state, maxwell_boltzmann};
+use super::{
+    Check, Experiment, ExperimentResult, Options, collision_rate, equation_of_state, equipartition, maxwell_boltzmann,
+    wall_pressure,
+};
 use crate::io::output::write_atomic;
 use std::fmt::Write as _;
 
 /// Every experiment, in report order.
-pub const EXPERIMENTS: &[(&str, Experiment)] =
-    &[(maxwell_boltzmann::NAME, maxwell_boltzmann::run), (equation_of_state::NAME, equation_of_state::run)];
+pub const EXPERIMENTS: &[(&str, Experiment)] = &[
+    (maxwell_boltzmann::NAME, maxwell_boltzmann::run),
+    (wall_pressure::NAME, wall_pressure::run),
+    (equation_of_state::NAME, equation_of_state::run),
+    (collision_rate::NAME, collision_rate::run),
+    (equipartition::NAME, equipartition::run),
+];
 
 /// The numerics self-check (the edge-case reference) as an experiment-like result.
 pub fn numerics(options: &Options) -> ExperimentResult {

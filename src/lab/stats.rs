@@ -5,7 +5,7 @@
 //! sheet). The kinetic energy `u²/2` is then exponential with rate 1, which is how the KS
 //! test is run (statrs' `Exp`, the same statistic since the map is monotone).
 
-use statrs::distribution::Exp;
+use statrs::distribution::{ContinuousCDF, Exp, StudentsT};
 use statrs::stats_tests::NaNPolicy;
 use statrs::stats_tests::ks_test::{KSOneSampleAlternativeMethod, ks_onesample};
 
@@ -23,6 +23,15 @@ pub fn ks_rayleigh(u: &[f64]) -> f64 {
 /// (asymptotic Kolmogorov distribution; physics reference sheet).
 pub fn ks_critical_95(n: usize) -> f64 {
     1.358 / (n as f64).sqrt()
+}
+
+/// The "3σ" factor for a mean whose standard error was *estimated* from `blocks` block
+/// averages: the 99.73 % two-sided quantile of Student's t with `blocks − 1` degrees of
+/// freedom (3.58 for 20 blocks, 4.09 for 10), so that a true null hypothesis fails with the
+/// same 0.27 % probability as a 3σ test with a known error.
+pub fn three_sigma_factor(blocks: usize) -> f64 {
+    let t = StudentsT::new(0.0, 1.0, (blocks.max(2) - 1) as f64).expect("valid degrees of freedom");
+    t.inverse_cdf(1.0 - 0.0027 / 2.0)
 }
 
 /// Bin edges for speed histograms: width 0.1 up to u = 5 (the tail beyond 5, where the
@@ -93,6 +102,12 @@ pub fn kurtosis(c: &[f64]) -> (f64, f64) {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn three_sigma_factor_tends_to_three() {
+        assert!((three_sigma_factor(20) - 3.58).abs() < 0.01, "{}", three_sigma_factor(20));
+        assert!((three_sigma_factor(100_000) - 3.0).abs() < 0.01);
+    }
 
     #[test]
     fn equal_speeds_are_far_from_maxwellian() {
