@@ -9,7 +9,7 @@
 //!
 //! Checks, per density (periodic box, triangular lattice start, equilibrated):
 //! * identity: the per-sample difference Γ − Γ(Z) has mean 0 within 3 block-average standard
-//!   errors (Student-t 3σ-equivalent for 20 blocks: 3.58);
+//!   errors (Student-t 3σ-equivalent for 20 blocks: 3.45);
 //! * Enskog with Henderson's g(σ), for η ≤ 0.5: |Γ − Γ_E| ≤ 3σ + the 0.5 % accuracy of
 //!   Henderson's Z carried to g (a relative Z/(Z − 1)·0.5 %) + |Γ|/N finite size.
 
@@ -117,7 +117,7 @@ pub fn checks_for(s: &RateState) -> Vec<Check> {
         s.identity_difference_err,
         0.0,
         k * s.identity_difference_err,
-        "exact in equilibrium (⟨|Δp|⟩ = √(πmkT)); 3σ-equivalent for a 20-block error (Student t: 3.58)",
+        "exact in equilibrium (⟨|Δp|⟩ = √(πmkT)); 3σ-equivalent for a 20-block error (Student t: 3.45)",
     )];
     if s.eta <= 0.5 {
         let g = g_henderson(s.eta);
@@ -129,7 +129,7 @@ pub fn checks_for(s: &RateState) -> Vec<Check> {
             s.gamma_err,
             expected,
             k * s.gamma_err + expected * 0.005 * zh / (zh - 1.0) + s.gamma / s.n_particles as f64,
-            "3σ-equivalent for a 20-block error (Student t: 3.58) + Henderson's 0.5 % in Z carried to g(σ) (×Z/(Z−1)) + Γ/N finite size",
+            "3σ-equivalent for a 20-block error (Student t: 3.45) + Henderson's 0.5 % in Z carried to g(σ) (×Z/(Z−1)) + Γ/N finite size",
         ));
     }
     checks

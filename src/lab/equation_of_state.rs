@@ -13,7 +13,7 @@
 //!   15 (2006), Table 1 (D = 2): excellent below η ≈ 0.2.
 //!
 //! Checks: η ≤ 0.2 against the virial series, 0.2 < η ≤ 0.5 against Henderson. Tolerance:
-//! the 3σ-equivalent for an error estimated from 20 blocks (Student t: 3.58 standard
+//! the 3σ-equivalent for an error estimated from 20 blocks (Student t: 3.45 standard
 //! errors), plus the reference's own accuracy (0.5 % for Henderson; the first
 //! omitted virial term, estimated as b₁₁η¹⁰ with b₁₁ ≈ 11, for the series), plus a
 //! finite-size allowance |Z − 1|/N (canonical corrections to the pressure are O(1/N)).
@@ -87,7 +87,7 @@ pub fn check_point(p: &Point) -> Option<Check> {
             p.z_err,
             z_virial(p.eta),
             k * p.z_err + truncation + finite_size,
-            "3σ-equivalent (Student t, 19 dof: 3.58 standard errors) + first omitted virial term (b₁₁η¹⁰/(1−η), b₁₁ ≈ 11) + |Z−1|/N finite size",
+            "3σ-equivalent (Student t, 19 dof: 3.45 standard errors) + first omitted virial term (b₁₁η¹⁰/(1−η), b₁₁ ≈ 11) + |Z−1|/N finite size",
         ))
     } else if p.eta <= 0.5 {
         let zh = z_henderson(p.eta);
@@ -97,7 +97,7 @@ pub fn check_point(p: &Point) -> Option<Check> {
             p.z_err,
             zh,
             k * p.z_err + 0.005 * zh + finite_size,
-            "3σ-equivalent (Student t, 19 dof: 3.58 standard errors) + Henderson's 0.5 % accuracy up to η ≈ 0.5 + |Z−1|/N finite size",
+            "3σ-equivalent (Student t, 19 dof: 3.45 standard errors) + Henderson's 0.5 % accuracy up to η ≈ 0.5 + |Z−1|/N finite size",
         ))
     } else {
         None

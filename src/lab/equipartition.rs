@@ -10,7 +10,7 @@
 //!
 //! Check, per case: over the second half of the run, the mean of kT_A − kT_B (sampled about
 //! every mean free time) is 0 within the 3σ-equivalent of its 20-block standard error
-//! (Student t with 19 degrees of freedom: 3.58 standard errors).
+//! (Student t with 19 degrees of freedom: 3.45 standard errors).
 
 use super::plot::{Chart, Series, draw};
 use super::stats::three_sigma_factor;
@@ -86,7 +86,7 @@ pub fn relax(
         error,
         0.0,
         three_sigma_factor(20) * error,
-        "3σ-equivalent for a 20-block error (Student t: 3.58 standard errors; samples decorrelate within ~5 τ); kT_s corrected for the zero total momentum",
+        "3σ-equivalent for a 20-block error (Student t: 3.45 standard errors; samples decorrelate within ~5 τ); kT_s corrected for the zero total momentum",
     );
     Ok((series, check))
 }

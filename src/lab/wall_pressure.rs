@@ -6,7 +6,7 @@
 //! (b) **Walled-box virial identity** at η = 0.4: ½(P_x + P_y)(L_x − σ)(L_y − σ) =
 //!     N·kT + (1/2t)·Σσ|Δp|, sample by sample; tolerance 3 block-average standard errors of
 //!     the difference (as everywhere a block error is used, the 3σ-equivalent Student-t
-//!     factor for 20 blocks, 3.58).
+//!     factor for 20 blocks, 3.45).
 //! (c) **Across densities**: walls adsorb disks, so the bulk density of a closed box is below
 //!     N/A_acc and the wall pressure sits below the bulk equation of state at N/A_acc by
 //!     O(σ/L). The density is therefore measured in the middle quarter of the box (the
@@ -171,7 +171,7 @@ pub fn eos_check(s: &WalledState) -> Option<Check> {
         s.p_wall_err,
         p_eos,
         three_sigma_factor(20) * sigma + 0.005 * p_eos,
-        "3σ-equivalent for 20-block errors (Student t: 3.58) on wall pressure and EOS-at-measured-density + Henderson's 0.5 %",
+        "3σ-equivalent for 20-block errors (Student t: 3.45) on wall pressure and EOS-at-measured-density + Henderson's 0.5 %",
     ))
 }
 
@@ -183,7 +183,7 @@ pub fn identity_check(s: &WalledState) -> Check {
         s.difference_err,
         0.0,
         three_sigma_factor(20) * s.difference_err,
-        "3σ-equivalent for a 20-block error (Student t: 3.58 standard errors) of the per-sample difference; exact identity",
+        "3σ-equivalent for a 20-block error (Student t: 3.45 standard errors) of the per-sample difference; exact identity",
     )
 }
 
