@@ -178,7 +178,13 @@ fn wall_pressure_quick_passes() {
 
 #[test]
 fn wall_pressure_checks_can_fail() {
-    use collide::lab::wall_pressure::{WalledState, eos_check, identity_check};
+    use collide::lab::wall_pressure::{WalledState, eos_check, ideal_gas_check, identity_check, one_disk};
+    // The one-disk ideal gas: right as measured; wrong by 1 %, or divided by the full box
+    // area instead of the accessible one, it fails.
+    let (p, expected, tolerance) = one_disk(2.0e4).unwrap();
+    assert!(ideal_gas_check(p, expected, tolerance).pass);
+    assert!(!ideal_gas_check(1.01 * p, expected, tolerance).pass);
+    assert!(!ideal_gas_check(p * (8.0 * 6.0) / (9.0 * 7.0), expected, tolerance).pass);
     let good = WalledState {
         eta: 0.4,
         n_particles: 1600,
@@ -190,7 +196,7 @@ fn wall_pressure_checks_can_fail() {
         difference: 0.001,
         difference_err: 0.003,
         n_mid: 0.5,
-        n_mid_err: 0.0005,
+        n_mid_tolerance: 0.0015,
         n_accessible: 0.52,
     };
     let truth = good.p_eos_mid().0;

@@ -34,6 +34,19 @@ pub fn three_sigma_factor(blocks: usize) -> f64 {
     t.inverse_cdf(1.0 - 0.0027 / 2.0)
 }
 
+/// A conservative 3σ-equivalent tolerance for the mean of a slowly correlated series: the
+/// largest of `three_sigma_factor(B)·SE_B` over B = 20, 10 and 5 blocks (a blocking analysis
+/// that does not trust a plateau the run may be too short to reach). Returns (mean, tolerance).
+pub fn conservative_tolerance(values: &[f64]) -> (f64, f64) {
+    let (mean, _) = crate::observe::block_error(values, 20);
+    let tolerance = [20, 10, 5]
+        .iter()
+        .map(|&b| three_sigma_factor(b) * crate::observe::block_error(values, b).1)
+        .filter(|t| t.is_finite())
+        .fold(0.0, f64::max);
+    (mean, tolerance)
+}
+
 /// Bin edges for speed histograms: width 0.1 up to u = 5 (the tail beyond 5, where the
 /// Rayleigh weight is 3.7·10⁻⁶, is folded into the last bin).
 pub fn speed_bins() -> Vec<f64> {
