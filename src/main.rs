@@ -36,7 +36,7 @@ enum Command {
 
 #[derive(Args)]
 struct ValidateArgs {
-    /// CI-sized experiments (seconds) instead of report quality (about a minute).
+    /// CI-sized experiments (seconds) instead of report quality (about three minutes).
     #[arg(long)]
     quick: bool,
     /// Seed of the initial states.
