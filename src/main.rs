@@ -10,6 +10,15 @@ use std::io::{self, BufWriter, IsTerminal};
 use std::path::PathBuf;
 use std::process::ExitCode;
 
+/// `println!` that stops quietly when stdout is closed (e.g. piped into `head`) instead of
+/// panicking.
+macro_rules! say {
+    ($($t:tt)*) => {{
+        use std::io::Write as _;
+        let _ = writeln!(std::io::stdout(), $($t)*);
+    }};
+}
+
 #[derive(Parser)]
 #[command(name = "collide", version, about = "Event-driven hard-disk dynamics on verified collision numerics")]
 struct Cli {
@@ -140,9 +149,9 @@ fn run(cli: Cli) -> Result<ExitCode> {
 
 fn check() -> Result<ExitCode> {
     let report = collide::quadratic::reference::check_all();
-    print!("{}", report.text);
+    say!("{}", report.text.trim_end());
     if report.failures == 0 {
-        println!("all {} reference cases agree with the exact answers", report.cases);
+        say!("all {} reference cases agree with the exact answers", report.cases);
         Ok(ExitCode::SUCCESS)
     } else {
         eprintln!("collide: {} of {} reference cases disagree with the exact answers", report.failures, report.cases);
@@ -177,7 +186,7 @@ fn roots(args: RootsArgs) -> Result<ExitCode> {
     };
     let num = |name: &str, s: &str| parse_text(s).with_context(|| format!("coefficient {name}"));
     let roots = collide::quadratic::solve(num("A", a)?, num("B", b)?, num("C", c)?)?;
-    println!(
+    say!(
         "{}",
         match roots {
             Roots::None => "none".to_string(),
@@ -223,7 +232,7 @@ fn contact(args: ContactArgs) -> Result<ExitCode> {
         radius: scalar(&args.radius2, "R2")?,
     };
     let t = contact_time_dyn(&first, &second).map_err(anyhow::Error::msg)?;
-    println!("{}", t.map_or_else(|| "never".to_string(), |t| format_text(t, format)));
+    say!("{}", t.map_or_else(|| "never".to_string(), |t| format_text(t, format)));
     Ok(ExitCode::SUCCESS)
 }
 
@@ -231,7 +240,7 @@ fn run_simulation(args: RunArgs) -> Result<ExitCode> {
     use collide::io::config::{Config, DEFAULT_CONFIG};
     use collide::io::output::{RunFailure, execute, load_checkpoint, run_config};
     if args.print_default {
-        print!("{DEFAULT_CONFIG}");
+        say!("{}", DEFAULT_CONFIG.trim_end());
         return Ok(ExitCode::SUCCESS);
     }
     let bar = if io::stderr().is_terminal() {
@@ -268,7 +277,7 @@ fn run_simulation(args: RunArgs) -> Result<ExitCode> {
         })?
     };
     bar.finish_and_clear();
-    println!(
+    say!(
         "{} collisions in {:.2} s ({:.3} M/s); kT = {:.6}; P = {:.6} ± {:.6}; Z = {:.5} ± {:.5}; max overlap {:.2e}; energy drift {:.2e}",
         summary.collisions,
         summary.wall_time_s,
@@ -281,7 +290,7 @@ fn run_simulation(args: RunArgs) -> Result<ExitCode> {
         summary.max_overlap.fraction,
         summary.energy_relative_drift
     );
-    println!("results in {}", args.out.display());
+    say!("results in {}", args.out.display());
     Ok(ExitCode::SUCCESS)
 }
 
@@ -290,12 +299,12 @@ fn validate(args: ValidateArgs) -> Result<ExitCode> {
     let options = Options { quick: args.quick, seed: args.seed, out: args.out };
     let results = validate(&options, |name| eprintln!("running {name} …")).map_err(anyhow::Error::msg)?;
     for r in &results {
-        print!("{}", table(&r.name, &r.checks));
+        say!("{}", table(&r.name, &r.checks).trim_end());
     }
     let failed: Vec<&str> = results.iter().filter(|r| !r.passed()).map(|r| r.name.as_str()).collect();
-    println!("report: {}", options.out.join("index.html").display());
+    say!("report: {}", options.out.join("index.html").display());
     if failed.is_empty() {
-        println!("all checks pass");
+        say!("all checks pass");
         Ok(ExitCode::SUCCESS)
     } else {
         eprintln!("collide: checks fail in {}", failed.join(", "));

@@ -21,6 +21,7 @@
 //! accuracy there, and above η ≈ 0.69 the liquid–hexatic transition (Bernard & Krauth 2011)
 //! brings slow equilibration and strong finite-size effects.
 
+use super::collision_rate::{g_henderson, gamma_enskog};
 use super::plot::{Chart, Series, draw};
 use super::stats::three_sigma_factor;
 use super::{Check, ExperimentResult, Options};
@@ -108,9 +109,7 @@ pub fn check_point(p: &Point) -> Option<Check> {
 pub fn measure(eta: f64, n: usize, equilibration: u64, production: u64, seed: u64) -> Result<Point, String> {
     // The sampling interval (time between rows) is a few mean free times; Enskog's estimate
     // with Henderson's contact value sets it (only for scheduling).
-    let density = 4.0 * eta / std::f64::consts::PI;
-    let g = (1.0 - 7.0 * eta / 16.0) / (1.0 - eta).powi(2);
-    let tau = 1.0 / (2.0 * density * g * std::f64::consts::PI.sqrt());
+    let tau = 1.0 / gamma_enskog(eta, g_henderson(eta));
     let samples_wanted = 100.0;
     let run_time = 2.0 * production as f64 / n as f64 * tau;
     let text = format!(

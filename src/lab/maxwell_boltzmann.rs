@@ -14,6 +14,7 @@
 //! A true Maxwellian fails the KS check with probability 5 % and each 3σ check with 0.3 %;
 //! the seed is fixed, so the verdict is reproducible.
 
+use super::collision_rate::{g_henderson, gamma_enskog};
 use super::plot::{Chart, Series, draw};
 use super::stats::{h_function, histogram, ks_critical_95, ks_rayleigh, kurtosis, sonine_a2, speed_bins};
 use super::{Check, ExperimentResult, Options};
@@ -118,9 +119,7 @@ pub fn run(options: &Options) -> Result<ExperimentResult, String> {
     let mut sim = Simulation::new(particles, sim_box).map_err(|e| e.to_string())?;
     // Enskog's mean free time, only to schedule the snapshots: Γ = 2nσ·g(σ)·√(πkT/m) with
     // Henderson's g(σ) = (1 − 7η/16)/(1 − η)² (physics reference sheet).
-    let density = n as f64 / sim_box.volume();
-    let g = (1.0 - 7.0 * eta / 16.0) / (1.0 - eta).powi(2);
-    let tau_enskog = 1.0 / (2.0 * density * g * std::f64::consts::PI.sqrt());
+    let tau_enskog = 1.0 / gamma_enskog(eta, g_henderson(eta));
     sim.sample_every(tau_enskog / 4.0);
 
     let snapshot = |sim: &Simulation<2>| {

@@ -95,8 +95,11 @@ pub fn main_for(name: &str, experiment: Experiment) -> ExitCode {
     let options = Options { quick: args.quick, seed: args.seed, out: args.out };
     match experiment(&options).and_then(|r| r.write(&options.out).map(|_| r).map_err(|e| e.to_string())) {
         Ok(result) => {
-            print!("{}", check::table(name, &result.checks));
-            println!("results in {}", ExperimentResult::dir(&options.out, name).display());
+            // Writes that fail (stdout closed, e.g. piped into `head`) are not errors of the run.
+            use std::io::Write as _;
+            let mut stdout = std::io::stdout();
+            let _ = write!(stdout, "{}", check::table(name, &result.checks));
+            let _ = writeln!(stdout, "results in {}", ExperimentResult::dir(&options.out, name).display());
             if result.passed() { ExitCode::SUCCESS } else { ExitCode::FAILURE }
         }
         Err(e) => {

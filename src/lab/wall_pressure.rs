@@ -18,6 +18,7 @@
 //!     pressure's 3σ-equivalent and the EOS pressure's (through the density's), in quadrature,
 //!     + 0.5 %.
 
+use super::collision_rate::{g_henderson, gamma_enskog};
 use super::equation_of_state::{z_henderson, z_slhy};
 use super::plot::{Chart, Series, draw};
 use super::stats::{conservative_tolerance, three_sigma_factor};
@@ -90,8 +91,7 @@ pub fn measure(eta: f64, n: usize, collisions_per_particle: u64, seed: u64) -> R
     );
     let mut config = Config::parse(&text, NAME).map_err(|e| e.to_string())?;
     // About 200 samples: the sampling interval from Enskog's collision rate (scheduling only).
-    let density = 4.0 * eta / PI;
-    let rate = 2.0 * density * (1.0 - 7.0 * eta / 16.0) / (1.0 - eta).powi(2) * PI.sqrt();
+    let rate = gamma_enskog(eta, g_henderson(eta));
     config.run.sample_interval = 2.0 * collisions_per_particle as f64 / rate / 200.0;
     let mut run = Run::new(config).map_err(|e| e.to_string())?;
     run.equilibrate(|_| {});
