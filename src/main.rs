@@ -34,6 +34,23 @@ enum Command {
     /// Runs every physics experiment and writes a validation report (`index.html`,
     /// `report.md`); the default when no command is given. Exits non-zero if a check fails.
     Validate(ValidateArgs),
+    /// Benchmark report: steady-state collisions per second over N × packing fraction,
+    /// written to DIR/bench.json, bench.md and collisions_per_second.svg.
+    Bench(BenchArgs),
+    /// One benchmark point in a process of its own (used by `collide bench`).
+    #[command(hide = true)]
+    BenchPoint {
+        #[arg(long)]
+        n: usize,
+        #[arg(long)]
+        eta: f64,
+        #[arg(long)]
+        warmup: u64,
+        #[arg(long)]
+        timed: u64,
+        #[arg(long, default_value_t = 1)]
+        seed: u64,
+    },
     /// Checks the numerics on this machine against the built-in edge-case reference;
     /// exits non-zero on any mismatch.
     Check,
@@ -60,6 +77,16 @@ impl Default for ValidateArgs {
     fn default() -> Self {
         ValidateArgs { quick: false, seed: 1, out: PathBuf::from("validation") }
     }
+}
+
+#[derive(Args)]
+struct BenchArgs {
+    /// A small matrix that finishes in under a minute (N = 10³, 10⁴).
+    #[arg(long)]
+    quick: bool,
+    /// Output directory.
+    #[arg(long, default_value = "bench")]
+    out: PathBuf,
 }
 
 #[derive(Args)]
@@ -141,6 +168,12 @@ fn run(cli: Cli) -> Result<ExitCode> {
     match cli.command.unwrap_or(Command::Validate(ValidateArgs::default())) {
         Command::Validate(args) => validate(args),
         Command::Check => check(),
+        Command::Bench(args) => bench(args),
+        Command::BenchPoint { n, eta, warmup, timed, seed } => {
+            let point = collide::lab::bench::measure(n, eta, warmup, timed, seed).map_err(anyhow::Error::msg)?;
+            say!("{}", serde_json::to_string(&point)?);
+            Ok(ExitCode::SUCCESS)
+        }
         Command::Run(args) => run_simulation(args),
         Command::Roots(args) => roots(args),
         Command::ContactTime(args) => contact(args),
@@ -310,4 +343,35 @@ fn validate(args: ValidateArgs) -> Result<ExitCode> {
         eprintln!("collide: checks fail in {}", failed.join(", "));
         Ok(ExitCode::FAILURE)
     }
+}
+
+fn bench(args: BenchArgs) -> Result<ExitCode> {
+    use collide::io::output::write_atomic;
+    use collide::lab::bench::{BenchPoint, chart, markdown, matrix};
+    let (points, warmup, timed) = matrix(args.quick);
+    let exe = std::env::current_exe().context("locating the collide binary")?;
+    let mut results = Vec::new();
+    for (n, eta) in points {
+        eprintln!("N = {n}, η = {eta} …");
+        let output = std::process::Command::new(&exe)
+            .args(["bench-point", "--n", &n.to_string(), "--eta", &eta.to_string()])
+            .args(["--warmup", &warmup.to_string(), "--timed", &timed(n).to_string()])
+            .output()
+            .context("running a benchmark point")?;
+        if !output.status.success() {
+            bail!("benchmark point N = {n}, η = {eta} failed: {}", String::from_utf8_lossy(&output.stderr));
+        }
+        let point: BenchPoint = serde_json::from_slice(&output.stdout).context("reading a benchmark point")?;
+        results.push(point);
+    }
+    std::fs::create_dir_all(&args.out).with_context(|| args.out.display().to_string())?;
+    let command = if args.quick { "collide bench --quick" } else { "collide bench" };
+    let md = markdown(&results, command, &collide::lab::report::machine());
+    write_atomic(&args.out.join("bench.json"), serde_json::to_string_pretty(&results)?.as_bytes())?;
+    write_atomic(&args.out.join("bench.md"), md.as_bytes())?;
+    collide::lab::plot::draw(&chart(&results), &args.out.join("collisions_per_second.svg"))
+        .map_err(anyhow::Error::msg)?;
+    say!("{}", md.trim_end());
+    say!("results in {}", args.out.display());
+    Ok(ExitCode::SUCCESS)
 }

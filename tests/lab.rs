@@ -258,3 +258,19 @@ fn equipartition_check_can_fail() {
     let (_, check) = relax([0.5, 0.5], 400, 300.0, 1, "long").unwrap();
     assert!(check.pass, "{check:?}");
 }
+
+/// One small benchmark point, its table row and its chart (speed itself is never asserted).
+#[test]
+fn bench_point_table_and_chart() {
+    use collide::lab::bench::{chart, markdown, measure};
+    let p = measure(300, 0.6, 1, 5_000, 1).unwrap();
+    assert_eq!(p.events_by_kind.pair, 5_000);
+    assert!(p.collisions_per_second > 0.0 && p.ns_per_collision > 0.0);
+    assert!(p.engine_bytes_per_particle > 100.0, "particles alone take more: {}", p.engine_bytes_per_particle);
+    let md = markdown(&[p.clone()], "collide bench --quick", "test machine");
+    assert!(md.contains("| 300 | 0.6 |") && md.contains("test machine") && md.contains("collide bench --quick"));
+    let dir = out("bench-chart");
+    std::fs::create_dir_all(&dir).unwrap();
+    collide::lab::plot::draw(&chart(&[p]), &dir.join("c.svg")).unwrap();
+    assert!(std::fs::read_to_string(dir.join("c.svg")).unwrap().contains("log₁₀ N"));
+}

@@ -72,6 +72,15 @@ impl<const D: usize> Cells<D> {
         cells
     }
 
+    /// Heap bytes held (capacities, not lengths).
+    pub fn memory_bytes(&self) -> usize {
+        use std::mem::size_of;
+        self.lists.capacity() * size_of::<Vec<usize>>()
+            + self.lists.iter().map(|l| l.capacity() * size_of::<usize>()).sum::<usize>()
+            + self.coords.capacity() * size_of::<[i64; D]>()
+            + self.slot.capacity() * size_of::<usize>()
+    }
+
     /// Cells per axis.
     pub fn counts(&self) -> [usize; D] {
         self.counts

@@ -5,6 +5,7 @@
 //! directory), returns an [`ExperimentResult`], and is also a binary
 //! (`cargo run --release --bin <name>`) through [`main_for`].
 
+pub mod bench;
 pub mod check;
 pub mod collision_rate;
 pub mod equation_of_state;

@@ -1,0 +1,167 @@
+//! The benchmark report: steady-state collisions per second across N and packing fraction.
+//!
+//! Each point builds a periodic box from a triangular lattice (Maxwell velocities, kT = 1),
+//! runs a warm-up that is not timed (so the lattice has melted and the queue has reached its
+//! working size), then times a fixed number of pair collisions on one core. Memory is
+//! reported twice: the engine's own account of its heap (capacities of the particle array,
+//! the event queue and the cells) and the process's peak resident set size when each point
+//! runs in a process of its own (`collide bench` does that).
+
+use super::plot::{Chart, Series};
+use crate::engine::init::{Placement, Species, Velocities, box_for_packing_fraction, initial_particles};
+use crate::engine::{Boundary, EventCounts, Simulation};
+use serde::{Deserialize, Serialize};
+use std::time::Instant;
+
+/// One measured configuration.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct BenchPoint {
+    /// N.
+    pub n_particles: usize,
+    /// Packing fraction.
+    pub packing_fraction: f64,
+    /// Untimed warm-up collisions.
+    pub warmup_collisions: u64,
+    /// Timed pair collisions.
+    pub collisions: u64,
+    /// Timed wall-clock seconds.
+    pub seconds: f64,
+    /// Pair collisions per second.
+    pub collisions_per_second: f64,
+    /// Nanoseconds per pair collision.
+    pub ns_per_collision: f64,
+    /// Processed events per second (all kinds, stale ones excluded).
+    pub events_per_second: f64,
+    /// Timed events by kind (stale = discarded invalid events).
+    pub events_by_kind: EventCounts,
+    /// The engine's heap (particles, queue, cells) per particle, bytes, at the end.
+    pub engine_bytes_per_particle: f64,
+    /// Peak resident set size of the process, bytes (when known).
+    pub peak_rss_bytes: Option<u64>,
+}
+
+/// The process's peak resident set size (Linux `VmHWM`), if readable.
+pub fn peak_rss_bytes() -> Option<u64> {
+    let status = std::fs::read_to_string("/proc/self/status").ok()?;
+    let line = status.lines().find(|l| l.starts_with("VmHWM:"))?;
+    let kb: u64 = line.split_whitespace().nth(1)?.parse().ok()?;
+    Some(kb * 1024)
+}
+
+/// Measures one point: `warmup_per_particle` untimed collisions per particle, then
+/// `timed` collisions.
+pub fn measure(n: usize, eta: f64, warmup_per_particle: u64, timed: u64, seed: u64) -> Result<BenchPoint, String> {
+    let species = vec![Species { count: n, radius: 0.5, mass: 1.0 }];
+    let sim_box = box_for_packing_fraction(&species, eta, [Boundary::Periodic; 2], Placement::Triangular, 1.0);
+    let particles = initial_particles(&species, &sim_box, Placement::Triangular, Velocities::Maxwell, 1.0, seed)
+        .map_err(|e| e.to_string())?;
+    let mut sim = Simulation::new(particles, sim_box).map_err(|e| e.to_string())?;
+    let warmup = warmup_per_particle * n as u64;
+    while sim.counts().pair < warmup {
+        sim.step().ok_or("the gas stopped")?;
+    }
+    let before = sim.counts();
+    let start = Instant::now();
+    let target = before.pair + timed;
+    while sim.counts().pair < target {
+        sim.step().ok_or("the gas stopped")?;
+    }
+    let seconds = start.elapsed().as_secs_f64();
+    let after = sim.counts();
+    let events_by_kind = EventCounts {
+        pair: after.pair - before.pair,
+        wall: after.wall - before.wall,
+        cell: after.cell - before.cell,
+        sample: after.sample - before.sample,
+        stale: after.stale - before.stale,
+    };
+    Ok(BenchPoint {
+        n_particles: n,
+        packing_fraction: eta,
+        warmup_collisions: warmup,
+        collisions: timed,
+        seconds,
+        collisions_per_second: timed as f64 / seconds,
+        ns_per_collision: seconds * 1e9 / timed as f64,
+        events_per_second: events_by_kind.total() as f64 / seconds,
+        events_by_kind,
+        engine_bytes_per_particle: sim.memory_bytes() as f64 / n as f64,
+        peak_rss_bytes: peak_rss_bytes(),
+    })
+}
+
+/// The matrix: (N, η) pairs, warm-up collisions per particle, timed collisions for N.
+pub fn matrix(quick: bool) -> (Vec<(usize, f64)>, u64, fn(usize) -> u64) {
+    let sizes: &[usize] = if quick { &[1_000, 10_000] } else { &[1_000, 10_000, 100_000, 1_000_000] };
+    let points = sizes.iter().flat_map(|&n| [0.3, 0.65].map(|eta| (n, eta))).collect();
+    if quick { (points, 2, |n| (2 * n as u64).max(200_000)) } else { (points, 5, |n| (5 * n as u64).max(2_000_000)) }
+}
+
+/// Today's date (UTC) as YYYY-MM-DD, from the system clock (civil-from-days).
+pub fn today() -> String {
+    let secs = std::time::SystemTime::now().duration_since(std::time::UNIX_EPOCH).map(|d| d.as_secs()).unwrap_or(0);
+    let z = (secs / 86_400) as i64 + 719_468;
+    let era = z.div_euclid(146_097);
+    let doe = z - era * 146_097;
+    let yoe = (doe - doe / 1_460 + doe / 36_524 - doe / 146_096) / 365;
+    let doy = doe - (365 * yoe + yoe / 4 - yoe / 100);
+    let mp = (5 * doy + 2) / 153;
+    let d = doy - (153 * mp + 2) / 5 + 1;
+    let m = if mp < 10 { mp + 3 } else { mp - 9 };
+    let y = yoe + era * 400 + i64::from(m <= 2);
+    format!("{y:04}-{m:02}-{d:02}")
+}
+
+/// The Markdown table of a report.
+pub fn markdown(points: &[BenchPoint], command: &str, machine: &str) -> String {
+    let mut md = format!(
+        "# collide benchmark report\n\n{} · collide {} · {machine} · one core\n\nCommand: `{command}`\n\n\
+         | N | η | collisions/s | ns/collision | events/s | pair : wall : cell : stale per collision | engine bytes/particle | peak RSS bytes/particle |\n\
+         |---|---|---|---|---|---|---|---|\n",
+        today(),
+        env!("CARGO_PKG_VERSION")
+    );
+    for p in points {
+        let e = &p.events_by_kind;
+        let per = |x: u64| x as f64 / e.pair.max(1) as f64;
+        md.push_str(&format!(
+            "| {} | {} | {:.3e} | {:.0} | {:.3e} | 1 : {:.2} : {:.2} : {:.2} | {:.0} | {} |\n",
+            p.n_particles,
+            p.packing_fraction,
+            p.collisions_per_second,
+            p.ns_per_collision,
+            p.events_per_second,
+            per(e.wall),
+            per(e.cell),
+            per(e.stale),
+            p.engine_bytes_per_particle,
+            p.peak_rss_bytes.map_or("—".into(), |b| format!("{:.0}", b as f64 / p.n_particles as f64)),
+        ));
+    }
+    md
+}
+
+/// The chart: collisions per second against N (log₁₀ N on the x axis), one line per η.
+pub fn chart(points: &[BenchPoint]) -> Chart {
+    let mut etas: Vec<f64> = points.iter().map(|p| p.packing_fraction).collect();
+    etas.dedup();
+    Chart {
+        title: "Steady-state collisions per second (one core)".into(),
+        x_label: "log₁₀ N (number of disks)".into(),
+        y_label: "collisions per second (10⁶/s)".into(),
+        legend_left: false,
+        series: etas
+            .iter()
+            .map(|&eta| {
+                Series::points(
+                    &format!("η = {eta}"),
+                    points
+                        .iter()
+                        .filter(|p| p.packing_fraction == eta)
+                        .map(|p| ((p.n_particles as f64).log10(), p.collisions_per_second / 1e6))
+                        .collect(),
+                )
+            })
+            .collect(),
+    }
+}
