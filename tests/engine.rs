@@ -161,3 +161,22 @@ fn fast_engine_matches_the_reference_from_dense_lattices() {
         assert_same_collisions(fast, slow, 5000, &format!("{placement:?}"));
     }
 }
+
+/// A sampling interval below the clock's resolution must not schedule samples at the same
+/// instant forever: sampling stops and the dynamics goes on.
+#[test]
+fn sampling_below_clock_resolution_does_not_hang() {
+    let p = vec![disk(10.0, 10.0, 1.0, 0.0, 0.5, 1.0), disk(12.0, 10.0, -0.5, 0.0, 0.5, 1.0)];
+    let mut sim = Simulation::new(p, square_box(40.0, Boundary::Periodic)).unwrap();
+    while sim.time() < 1.0 {
+        sim.step().unwrap();
+    }
+    sim.sample_every(1e-300);
+    let mut samples = 0;
+    for _ in 0..1000 {
+        if let Outcome::Sample = sim.step().unwrap() {
+            samples += 1;
+        }
+    }
+    assert!(samples <= 1, "{samples} samples at one instant");
+}

@@ -497,7 +497,11 @@ impl<const D: usize> Simulation<D> {
             }
             EventKind::Sample => {
                 self.counts.sample += 1;
-                if let Some(dt) = self.sampling {
+                // An interval below the resolution of the clock (t + dt = t) would sample at
+                // the same instant forever: sampling stops instead.
+                if let Some(dt) = self.sampling
+                    && t + dt > t
+                {
                     self.push(Event { time: t + dt, i: usize::MAX, i_events: 0, kind: EventKind::Sample });
                 }
                 Outcome::Sample

@@ -262,6 +262,14 @@ impl Config {
             return Err(format!("equilibration.time = {t}: must be a finite number ≥ 0"));
         }
         positive("run.sample_interval", self.run.sample_interval)?;
+        if let Some(t) = self.run.time
+            && t / self.run.sample_interval > 1e8
+        {
+            return Err(format!(
+                "run.sample_interval = {}: with run.time = {t} that is more than 10⁸ samples; use a larger interval",
+                self.run.sample_interval
+            ));
+        }
         if self.run.blocks < 2 {
             return Err(format!("run.blocks = {}: must be at least 2 (error bars need two blocks)", self.run.blocks));
         }
@@ -306,5 +314,7 @@ mod tests {
         let typo = error_of("placement = \"triangular\"", "placement = \"hexagonal\"");
         assert!(typo.contains("hexagonal"), "{typo}");
         assert!(Config::parse("this is not toml", "x.toml").unwrap_err().to_string().starts_with("x.toml: "));
+        let flood = error_of("sample_interval = 1.0", "sample_interval = 1e-12\ntime = 10.0");
+        assert!(flood.contains("more than 10⁸ samples"), "{flood}");
     }
 }
