@@ -65,6 +65,18 @@ pub struct Event {
 }
 
 impl Event {
+    /// Whether the event still holds: every particle it involves has the event count it had
+    /// when the event was predicted (samples are always valid).
+    pub fn is_valid<const D: usize>(&self, particles: &[Particle<D>]) -> bool {
+        match self.kind {
+            EventKind::Sample => true,
+            EventKind::Pair { j, j_events } => {
+                particles[self.i].events == self.i_events && particles[j].events == j_events
+            }
+            _ => particles[self.i].events == self.i_events,
+        }
+    }
+
     /// The total order of events: by time, then pair < wall < cell < sample, then by the
     /// particles and axes involved. No two distinct live events compare equal, so the
     /// sequence of events never depends on the order in which they were pushed.

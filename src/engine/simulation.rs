@@ -63,6 +63,17 @@ pub struct EventCounts {
 }
 
 impl EventCounts {
+    /// The events counted since `earlier` (a snapshot of the same counter).
+    pub fn since(&self, earlier: &EventCounts) -> EventCounts {
+        EventCounts {
+            pair: self.pair - earlier.pair,
+            wall: self.wall - earlier.wall,
+            cell: self.cell - earlier.cell,
+            sample: self.sample - earlier.sample,
+            stale: self.stale - earlier.stale,
+        }
+    }
+
     /// Every processed event (stale ones excluded).
     pub fn total(&self) -> u64 {
         self.pair + self.wall + self.cell + self.sample
@@ -398,14 +409,7 @@ impl<const D: usize> Simulation<D> {
     fn compact_if_large(&mut self) {
         if self.queue.len() > self.compact_at {
             let before = self.queue.len();
-            let particles = &self.particles;
-            self.queue.retain(|Queued(e)| match e.kind {
-                EventKind::Sample => true,
-                EventKind::Pair { j, j_events } => {
-                    particles[e.i].events == e.i_events && particles[j].events == j_events
-                }
-                _ => particles[e.i].events == e.i_events,
-            });
+            self.queue.retain(|Queued(e)| e.is_valid(&self.particles));
             self.counts.stale += (before - self.queue.len()) as u64;
             self.compact_at = (2 * self.queue.len()).max(4 * self.particles.len() + 1024);
         }
@@ -444,23 +448,13 @@ impl<const D: usize> Simulation<D> {
         }
     }
 
-    fn is_valid(&self, e: &Event) -> bool {
-        match e.kind {
-            EventKind::Sample => true,
-            EventKind::Pair { j, j_events } => {
-                self.particles[e.i].events == e.i_events && self.particles[j].events == j_events
-            }
-            _ => self.particles[e.i].events == e.i_events,
-        }
-    }
-
     /// Processes the next valid event and reports it; `None` when nothing can happen any
     /// more (no event left in the queue).
     pub fn step(&mut self) -> Option<Outcome<D>> {
         self.compact_if_large();
         loop {
             let Queued(e) = self.queue.pop()?;
-            if !self.is_valid(&e) {
+            if !e.is_valid(&self.particles) {
                 self.counts.stale += 1;
                 continue;
             }

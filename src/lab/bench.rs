@@ -67,14 +67,7 @@ pub fn measure(n: usize, eta: f64, warmup_per_particle: u64, timed: u64, seed: u
         sim.step().ok_or("the gas stopped")?;
     }
     let seconds = start.elapsed().as_secs_f64();
-    let after = sim.counts();
-    let events_by_kind = EventCounts {
-        pair: after.pair - before.pair,
-        wall: after.wall - before.wall,
-        cell: after.cell - before.cell,
-        sample: after.sample - before.sample,
-        stale: after.stale - before.stale,
-    };
+    let events_by_kind = sim.counts().since(&before);
     Ok(BenchPoint {
         n_particles: n,
         packing_fraction: eta,
