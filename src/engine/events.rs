@@ -8,7 +8,7 @@
 use super::collision::{Body, Impulse, Restitution, resolve_pair};
 use super::geometry::{Boundary, Particle, SimBox};
 use nalgebra::SVector;
-use quadratic::{Ball, Contact, contact_time_unchecked};
+use quadratic::{Ball, Bracket, Contact, contact_bracket, contact_time_within};
 use serde::{Deserialize, Serialize};
 use std::cmp::Ordering;
 
@@ -90,22 +90,6 @@ impl Event {
     }
 }
 
-/// Min-ordered wrapper for `BinaryHeap` (a max-heap).
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct Queued(pub Event);
-
-impl Eq for Queued {}
-impl PartialOrd for Queued {
-    fn partial_cmp(&self, other: &Self) -> Option<Ordering> {
-        Some(self.cmp(other))
-    }
-}
-impl Ord for Queued {
-    fn cmp(&self, other: &Self) -> Ordering {
-        other.0.order(&self.0)
-    }
-}
-
 /// The positions of `i` and of the image of `j` nearest to it, at time `t`.
 pub fn pair_positions<const D: usize>(
     pi: &Particle<D>,
@@ -142,15 +126,35 @@ pub fn predict_pair<const D: usize>(
     now: f64,
     short: &[bool; D],
 ) -> Option<f64> {
+    predict_pair_within(pi, pj, sim_box, now, short, f64::INFINITY)
+}
+
+/// [`predict_pair`] for a caller that only wants contacts at or before the absolute time
+/// `horizon` (the earliest event found so far for a particle).
+///
+/// Returns `None` only when the pair certainly has no contact whose rounded absolute time
+/// is `≤ horizon` — so an event that would tie with the horizon (and might win the tie) is
+/// never dropped; otherwise exactly what [`predict_pair`] returns. The kernel's
+/// [`contact_time_within`] does the rejection before any double-double arithmetic.
+#[inline]
+pub fn predict_pair_within<const D: usize>(
+    pi: &Particle<D>,
+    pj: &Particle<D>,
+    sim_box: &SimBox<D>,
+    now: f64,
+    short: &[bool; D],
+    horizon: f64,
+) -> Option<f64> {
     // Image counts (integers); a shift is always formed as one product count·L, so the same
     // image gives the same bits however it was reached.
     let base = sim_box.minimum_image_count(&(pj.position_at(now) - pi.position_at(now)));
     let t0 = pi.time.max(pj.time);
+    let h = relative_horizon(horizon, t0);
     let (ri, rj) = (pi.position_at(t0), pj.position_at(t0));
     let a = Ball { position: ri.into(), velocity: pi.velocity.into(), radius: pi.radius };
     let earliest = |shift: &SVector<f64, D>| {
         let b = Ball { position: (rj + shift).into(), velocity: pj.velocity.into(), radius: pj.radius };
-        match contact_time_unchecked(&a, &b) {
+        match contact_time_within(&a, &b, h)? {
             Contact::Never(_) => None,
             Contact::Now => Some(t0),
             Contact::At(dt) => Some(t0 + dt),
@@ -186,6 +190,73 @@ pub fn predict_pair<const D: usize>(
             return best;
         }
         offset[a] += 1;
+    }
+}
+
+/// What [`bracket_pair`] knows about a pair's contact, in absolute time.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum PairBracket {
+    /// Certainly no contact at or before the horizon.
+    Beyond,
+    /// Exactly what [`predict_pair`] returns.
+    Known(Option<f64>),
+    /// [`predict_pair`] returns `Some(t)` with `lo ≤ t ≤ hi`.
+    Between {
+        /// Lower end.
+        lo: f64,
+        /// Upper end.
+        hi: f64,
+    },
+}
+
+/// A certified bracket of [`predict_pair`]'s answer, without its double-double root
+/// ([`contact_bracket`]): the engine brackets every neighbour of a particle and evaluates
+/// exactly only those whose lower end does not exceed the smallest upper end. The bracket
+/// `[t0 ⊕ lo, t0 ⊕ hi]` holds `t0 ⊕ Δt` because rounding is monotone. Along short axes
+/// (several images) it falls back to [`predict_pair_within`].
+#[inline]
+pub fn bracket_pair<const D: usize>(
+    pi: &Particle<D>,
+    pj: &Particle<D>,
+    sim_box: &SimBox<D>,
+    now: f64,
+    short: &[bool; D],
+    horizon: f64,
+) -> PairBracket {
+    if short.iter().any(|&s| s) {
+        return match predict_pair_within(pi, pj, sim_box, now, short, horizon) {
+            None => PairBracket::Beyond,
+            known => PairBracket::Known(known),
+        };
+    }
+    let base = sim_box.minimum_image_count(&(pj.position_at(now) - pi.position_at(now)));
+    let t0 = pi.time.max(pj.time);
+    let h = relative_horizon(horizon, t0);
+    let (ri, rj) = (pi.position_at(t0), pj.position_at(t0));
+    let a = Ball { position: ri.into(), velocity: pi.velocity.into(), radius: pi.radius };
+    let b = Ball {
+        position: (rj + base.component_mul(&sim_box.lengths)).into(),
+        velocity: pj.velocity.into(),
+        radius: pj.radius,
+    };
+    match contact_bracket(&a, &b, h) {
+        Bracket::Beyond => PairBracket::Beyond,
+        Bracket::Known(Contact::Never(_)) => PairBracket::Known(None),
+        Bracket::Known(Contact::Now) => PairBracket::Known(Some(t0)),
+        Bracket::Known(Contact::At(dt)) => PairBracket::Known(Some(t0 + dt)),
+        Bracket::Between { lo, hi } => PairBracket::Between { lo: t0 + lo, hi: t0 + hi },
+    }
+}
+
+/// The horizon relative to `t0`, widened so that a dropped contact (exact Δt > h) rounds to
+/// an absolute time `t0 ⊕ Δt > horizon`: the margin 2⁻⁴⁴·(|horizon| + |t0|) exceeds the
+/// rounding of both subtractions and of the final addition by a factor of over 100.
+#[inline]
+fn relative_horizon(horizon: f64, t0: f64) -> f64 {
+    if horizon == f64::INFINITY {
+        f64::INFINITY
+    } else {
+        (horizon - t0) + f64::from_bits(0x3D30_0000_0000_0000) * (horizon.abs() + t0.abs())
     }
 }
 
@@ -244,5 +315,99 @@ pub fn resolve_wall_event<const D: usize>(p: &mut Particle<D>, axis: usize, uppe
         2.0 * p.mass * v.abs()
     } else {
         0.0
+    }
+}
+
+/// A particle's one pending event (the fast engine keeps exactly one per particle).
+///
+/// A pair event is stored with the partner's event counter at prediction: when the partner
+/// has changed velocity since, the event has become a *re-prediction marker* — its time is
+/// still a lower bound on every event of the owner that it stood for, so when it comes up
+/// the owner is simply predicted again. The owner's own counter is not stored: whenever the
+/// owner changes velocity it is predicted again at once.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+pub struct Pending {
+    /// When (`+∞` for nothing).
+    pub time: f64,
+    /// What.
+    pub kind: PendingKind,
+}
+
+/// What a [`Pending`] event is about.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+pub enum PendingKind {
+    /// Nothing will ever happen to this particle (it is at rest and alone).
+    Nothing,
+    /// A collision with `partner`, valid while the partner's counter is `partner_events`.
+    Pair {
+        /// The other particle.
+        partner: u32,
+        /// Its event counter at prediction.
+        partner_events: u64,
+    },
+    /// The owner hits the `upper` or lower wall of `axis`.
+    Wall {
+        /// The axis.
+        axis: u8,
+        /// Upper (at L) or lower (at 0) wall.
+        upper: bool,
+    },
+    /// The owner leaves its cell along `axis`, `up` or down.
+    Cell {
+        /// The axis.
+        axis: u8,
+        /// Direction.
+        up: bool,
+    },
+}
+
+/// Rank of a sampling event among events at the same instant (after pairs, walls, cells).
+pub const SAMPLE_RANK: u8 = 3;
+
+impl Pending {
+    /// Nothing pending.
+    pub const NOTHING: Pending = Pending { time: f64::INFINITY, kind: PendingKind::Nothing };
+
+    /// The tie-break key of `owner`'s pending event, the same as [`Event::order`] after the
+    /// time: kind rank (pair < wall < cell < sample < nothing), lower particle, then partner
+    /// or axis and direction.
+    #[inline]
+    pub fn key(&self, owner: u32) -> (u8, u32, u32, u8) {
+        match self.kind {
+            PendingKind::Pair { partner, .. } => (0, owner.min(partner), owner.max(partner), 0),
+            PendingKind::Wall { axis, upper } => (1, owner, axis as u32, upper as u8),
+            PendingKind::Cell { axis, up } => (2, owner, axis as u32, up as u8),
+            PendingKind::Nothing => (SAMPLE_RANK + 1, owner, 0, 0),
+        }
+    }
+
+    /// Whether this event (of `owner`) comes before `other`'s (of `other_owner`).
+    #[inline]
+    pub fn before(&self, owner: u32, other: &Pending, other_owner: u32) -> bool {
+        self.time < other.time || (self.time == other.time && self.key(owner) < other.key(other_owner))
+    }
+
+    /// The event in the public form, for the owner `owner` whose counter is `owner_events`.
+    pub fn event(&self, owner: u32, owner_events: u64) -> Option<Event> {
+        let i = owner as usize;
+        let kind = match self.kind {
+            PendingKind::Nothing => return None,
+            PendingKind::Pair { partner, partner_events } => {
+                let (lo, lo_events, hi, hi_events) = if owner < partner {
+                    (owner, owner_events, partner, partner_events)
+                } else {
+                    (partner, partner_events, owner, owner_events)
+                };
+                return Some(Event {
+                    time: self.time,
+                    i: lo as usize,
+                    i_events: lo_events,
+                    kind: EventKind::Pair { j: hi as usize, j_events: hi_events },
+                });
+            }
+            PendingKind::Wall { axis, upper } => EventKind::Wall { axis: axis as usize, upper },
+            PendingKind::Cell { axis, up } => EventKind::Cell { axis: axis as usize, up },
+        };
+        Some(Event { time: self.time, i, i_events: owner_events, kind })
     }
 }

@@ -6,6 +6,7 @@
 //! * [`collision`]: the velocity update and the [`Impulse`] it reports.
 //! * [`events`]: event types, their total order, the pure predictions.
 //! * [`cells`]: the cell grid.
+//! * [`queue`]: one pending event per particle, in a tournament tree.
 //! * [`simulation`]: the event loop.
 //! * [`reference`]: the O(N²) reference.
 //! * [`init`]: initial states (lattices, random placement, Maxwell or fixed-speed velocities).
@@ -15,6 +16,7 @@ pub mod collision;
 pub mod events;
 pub mod geometry;
 pub mod init;
+pub mod queue;
 pub mod reference;
 pub mod simulation;
 

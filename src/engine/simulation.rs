@@ -1,21 +1,31 @@
 //! The event loop: one [`Simulation`] owns the particles, the event queue, the cell grid,
 //! the box and the clock.
 //!
-//! `step()` pops the earliest *valid* event (an event is stale when a particle it involves
-//! has changed velocity since it was predicted — per-particle event counters), advances
-//! the particles it involves to the event time, resolves it, re-predicts what changed, and
-//! returns an [`Outcome`] describing what happened, for the observers.
+//! Each particle has exactly one pending event — the earliest of its collisions with the
+//! particles in the cells around it, its next wall and its next cell crossing — held in a
+//! tournament tree ([`EventQueue`]). `step()` takes the earliest; a pair event whose partner
+//! has changed velocity since it was predicted (per-particle event counters) is a
+//! re-prediction marker: its owner is predicted again and nothing happens. Otherwise the
+//! particles involved are advanced to the event time, the event is resolved, they are
+//! predicted again, and an [`Outcome`] describes what happened, for the observers.
+//!
+//! Why this finds every collision: each pair is *covered* by the pending event of one of
+//! its particles, whose time is no later than the pair's contact. Predicting a particle
+//! covers all its pairs (it takes the minimum over them); a pair stays covered when the
+//! covering event turns into a marker, because the marker's time is still no later than
+//! the pair's contact and coming up re-covers it. The brute-force
+//! [`ReferenceSimulation`](super::ReferenceSimulation) checks this bit for bit.
 
 use super::cells::Cells;
 use super::collision::{Impulse, Restitution};
 use super::events::{
-    Event, EventKind, Queued, pair_positions, predict_pair, predict_wall, resolve_pair_event, resolve_wall_event,
-    short_axes,
+    PairBracket, Pending, PendingKind, SAMPLE_RANK, bracket_pair, pair_positions, predict_pair, predict_wall,
+    resolve_pair_event, resolve_wall_event, short_axes,
 };
 use super::geometry::{Boundary, Particle, SimBox};
+use super::queue::EventQueue;
 use nalgebra::SVector;
 use serde::{Deserialize, Serialize};
-use std::collections::BinaryHeap;
 use std::fmt;
 
 /// What one step did.
@@ -58,7 +68,8 @@ pub struct EventCounts {
     pub cell: u64,
     /// Sampling events.
     pub sample: u64,
-    /// Stale events discarded (popped, or dropped when the queue is compacted).
+    /// Re-prediction markers processed: pair events whose partner had changed velocity
+    /// since they were predicted (nothing happens but a new prediction for the owner).
     pub stale: u64,
 }
 
@@ -113,6 +124,16 @@ pub enum SetupError {
         /// Its coordinate.
         coordinate: f64,
     },
+    /// More particles than the engine indexes (32-bit indices).
+    TooMany {
+        /// How many were given.
+        n: usize,
+    },
+    /// A saved state that does not fit together.
+    BadState {
+        /// What is wrong.
+        what: String,
+    },
     /// Two particles overlap.
     Overlap {
         /// Lower index.
@@ -144,6 +165,10 @@ impl fmt::Display for SetupError {
             SetupError::OutsideBox { index, axis, coordinate } => {
                 write!(f, "particle {index} is outside the walls along axis {axis} (coordinate {coordinate})")
             }
+            SetupError::TooMany { n } => {
+                write!(f, "{n} particles: the engine handles at most {}", u32::MAX - 1)
+            }
+            SetupError::BadState { what } => write!(f, "inconsistent saved state: {what}"),
             SetupError::Overlap { i, j, fraction } => {
                 write!(f, "particles {i} and {j} overlap by {:.3e} of their contact distance", fraction)
             }
@@ -163,19 +188,23 @@ pub struct OverlapAudit {
     pub at: Option<(usize, usize)>,
 }
 
+/// Brackets kept per prediction before falling back to exact evaluation on the spot (a
+/// particle rarely has more than a handful of approaching neighbours).
+const HITS: usize = 32;
+
 /// An event-driven simulation of hard disks (`D = 2`) or spheres.
 #[derive(Clone, Debug)]
 pub struct Simulation<const D: usize> {
     particles: Vec<Particle<D>>,
     sim_box: SimBox<D>,
     cells: Cells<D>,
-    queue: BinaryHeap<Queued>,
+    queue: EventQueue,
     time: f64,
     short: [bool; D],
     restitution: Restitution,
     counts: EventCounts,
     sampling: Option<f64>,
-    compact_at: usize,
+    next_sample: Option<f64>,
 }
 
 /// The saved state of a [`Simulation`]: enough to continue bit-identically.
@@ -185,37 +214,37 @@ pub struct SimulationState<const D: usize> {
     pub particles: Vec<Particle<D>>,
     /// Unwrapped cell coordinates, one list per particle.
     pub cells: Vec<Vec<i64>>,
-    /// Every queued event (stale ones included).
-    pub queue: Vec<Event>,
+    /// Each particle's pending event (re-prediction markers included).
+    pub pending: Vec<Pending>,
     /// The clock.
     pub time: f64,
     /// Event counts so far.
     pub counts: EventCounts,
     /// Sampling interval, if sampling.
     pub sampling: Option<f64>,
-    /// Queue length that triggers the next compaction.
-    pub compact_at: usize,
+    /// The next sampling instant, if sampling.
+    pub next_sample: Option<f64>,
 }
 
 impl<const D: usize> Simulation<D> {
     /// Validates the particles and the box and predicts every first event.
-    pub fn new(particles: Vec<Particle<D>>, sim_box: SimBox<D>) -> Result<Self, SetupError> {
+    pub fn new(mut particles: Vec<Particle<D>>, sim_box: SimBox<D>) -> Result<Self, SetupError> {
         let reach = validate(&particles, &sim_box)?;
+        particles.shrink_to_fit();
         let cells = Cells::new(&sim_box, reach, particles.iter().map(|p| p.position_at(p.time)));
         let time = particles.iter().map(|p| p.time).fold(f64::NEG_INFINITY, f64::max);
         let mut sim = Simulation {
+            queue: EventQueue::new(vec![Pending::NOTHING; particles.len()]),
             particles,
             short: short_axes(&sim_box, reach),
             sim_box,
             cells,
-            queue: BinaryHeap::new(),
             time,
             restitution: Restitution::ELASTIC,
             counts: EventCounts::default(),
             sampling: None,
-            compact_at: 0,
+            next_sample: None,
         };
-        sim.compact_at = 4 * sim.particles.len() + 1024;
         if let Some(audit) = sim.overlap_beyond(0.0) {
             let (i, j) = audit.at.expect("an overlap has a place");
             if i == j {
@@ -243,6 +272,24 @@ impl<const D: usize> Simulation<D> {
     /// Restores a saved state (see [`Simulation::state`]).
     pub fn restore(state: SimulationState<D>, sim_box: SimBox<D>) -> Result<Self, SetupError> {
         let reach = validate(&state.particles, &sim_box)?;
+        let n = state.particles.len();
+        let bad = |what: String| Err(SetupError::BadState { what });
+        if state.cells.len() != n || state.cells.iter().any(|c| c.len() != D) {
+            return bad(format!("{} cell coordinates of {D} axes expected, one per particle", n));
+        }
+        if state.pending.len() != n {
+            return bad(format!("{} pending events for {n} particles", state.pending.len()));
+        }
+        for (owner, p) in state.pending.iter().enumerate() {
+            let fine = match p.kind {
+                PendingKind::Pair { partner, .. } => (partner as usize) < n && partner as usize != owner,
+                PendingKind::Wall { axis, .. } | PendingKind::Cell { axis, .. } => (axis as usize) < D,
+                PendingKind::Nothing => true,
+            };
+            if !fine || p.time.is_nan() {
+                return bad(format!("pending event {owner} is {p:?}"));
+            }
+        }
         let coords = state
             .cells
             .iter()
@@ -257,34 +304,32 @@ impl<const D: usize> Simulation<D> {
             particles: state.particles,
             short: short_axes(&sim_box, reach),
             sim_box,
-            queue: state.queue.into_iter().map(Queued).collect(),
+            queue: EventQueue::new(state.pending),
             time: state.time,
             restitution: Restitution::ELASTIC,
             counts: state.counts,
             sampling: state.sampling,
-            compact_at: state.compact_at,
+            next_sample: state.next_sample,
         })
     }
 
     /// The complete state, for checkpoints.
     pub fn state(&self) -> SimulationState<D> {
-        let mut queue: Vec<Event> = self.queue.iter().map(|q| q.0).collect();
-        queue.sort_by(|a, b| a.order(b));
         SimulationState {
             particles: self.particles.clone(),
             cells: self.cells.coords().iter().map(|m| m.to_vec()).collect(),
-            queue,
+            pending: self.queue.pending().to_vec(),
             time: self.time,
             counts: self.counts,
             sampling: self.sampling,
-            compact_at: self.compact_at,
+            next_sample: self.next_sample,
         }
     }
 
     /// Schedules sampling events every `interval`, the first at `now + interval`.
     pub fn sample_every(&mut self, interval: f64) {
         self.sampling = Some(interval);
-        self.push(Event { time: self.time + interval, i: usize::MAX, i_events: 0, kind: EventKind::Sample });
+        self.next_sample = Some(self.time + interval);
     }
 
     /// The clock.
@@ -309,15 +354,7 @@ impl<const D: usize> Simulation<D> {
 
     /// Heap bytes held by the particles, the queue and the cells (capacities).
     pub fn memory_bytes(&self) -> usize {
-        use std::mem::size_of;
-        self.particles.capacity() * size_of::<Particle<D>>()
-            + self.queue.capacity() * size_of::<Queued>()
-            + self.cells.memory_bytes()
-    }
-
-    /// Events waiting in the queue (stale ones included).
-    pub fn queue_len(&self) -> usize {
-        self.queue.len()
+        self.particles.capacity() * size_of::<Particle<D>>() + self.queue.memory_bytes() + self.cells.memory_bytes()
     }
 
     /// Cells per axis.
@@ -396,111 +433,142 @@ impl<const D: usize> Simulation<D> {
         worst.at.map(|_| worst)
     }
 
-    fn push(&mut self, event: Event) {
-        self.queue.push(Queued(event));
-    }
-
-    /// Drops the stale events once the queue has doubled since the last compaction (and
-    /// holds more than 4N entries). Stale events would be skipped when popped anyway, so the
-    /// sequence of events is unchanged; what changes is the size of the heap every pop walks
-    /// (measured: 7.8 → 2.2 µs per collision at N = 10⁴, η = 0.65). Each compaction costs
-    /// O(queue) and comes after as many pushes, so the cost per push stays O(1). The
-    /// threshold is part of the saved state, so resumed runs stay bit-identical.
-    fn compact_if_large(&mut self) {
-        if self.queue.len() > self.compact_at {
-            let before = self.queue.len();
-            self.queue.retain(|Queued(e)| e.is_valid(&self.particles));
-            self.counts.stale += (before - self.queue.len()) as u64;
-            self.compact_at = (2 * self.queue.len()).max(4 * self.particles.len() + 1024);
-        }
-    }
-
-    /// Predicts every event of particle `i` (pairs with its neighbours, a wall, its next cell
-    /// crossing) and queues them. `except` skips one partner (just resolved with `i`).
+    /// Predicts particle `i`'s earliest event — a wall, its next cell crossing, or a
+    /// collision with a particle in the cells around it — and makes it `i`'s pending event.
+    /// `except` skips one partner (just resolved with `i`; the partner's own prediction
+    /// covers the pair).
+    ///
+    /// Walls and the cell crossing come first so that the pairs are searched against a
+    /// finite horizon. Pairs are then bracketed ([`bracket_pair`]: the kernel's f64 filter
+    /// with error bounds, no double-double root), and only those whose bracket reaches down
+    /// to the earliest certain time are evaluated exactly. The result is the same event as
+    /// evaluating every pair exactly: nothing is dropped that could come first or tie.
     fn predict(&mut self, i: usize, except: Option<usize>) {
         let p = &self.particles[i];
-        let mut found: Vec<Event> = Vec::new();
-        for j in self.cells.neighbours(i) {
-            if j == i || Some(j) == except {
-                continue;
+        let now = self.time;
+        let owner = i as u32;
+        let mut best = Pending::NOTHING;
+        let consider = |best: &mut Pending, e: Pending| {
+            if e.before(owner, best, owner) {
+                *best = e;
             }
-            let (lo, hi) = if i < j { (i, j) } else { (j, i) };
-            let (a, b) = (&self.particles[lo], &self.particles[hi]);
-            if let Some(t) = predict_pair(a, b, &self.sim_box, self.time, &self.short) {
-                found.push(Event {
-                    time: t.max(self.time),
-                    i: lo,
-                    i_events: a.events,
-                    kind: EventKind::Pair { j: hi, j_events: b.events },
-                });
-            }
-        }
+        };
         if let Some((t, axis, upper)) = predict_wall(p, &self.sim_box) {
-            found.push(Event { time: t.max(self.time), i, i_events: p.events, kind: EventKind::Wall { axis, upper } });
+            consider(&mut best, Pending { time: t.max(now), kind: PendingKind::Wall { axis: axis as u8, upper } });
         }
         let m = self.cells.coord(i);
         if let Some((dt, axis, up)) = self.cells.next_crossing(&m, &p.position, &p.velocity) {
-            let t = (p.time + dt).max(self.time);
-            found.push(Event { time: t, i, i_events: p.events, kind: EventKind::Cell { axis, up } });
+            let t = (p.time + dt).max(now);
+            consider(&mut best, Pending { time: t, kind: PendingKind::Cell { axis: axis as u8, up } });
         }
-        for e in found {
-            self.push(e);
+        // Pass 1: bracket every neighbour; `bound` is the earliest time some candidate is
+        // certain to reach (an exact event time, or the upper end of a bracket).
+        let skip = except.unwrap_or(i);
+        let mut bound = best.time;
+        let mut hits = [(0u32, 0.0f64); HITS];
+        let mut n_hits = 0;
+        let around = self.cells.around(i);
+        for &c in around.as_slice() {
+            for j in self.cells.members(c) {
+                let j = j as usize;
+                if j == i || j == skip {
+                    continue;
+                }
+                let q = &self.particles[j];
+                let (a, b) = if i < j { (p, q) } else { (q, p) };
+                let kind = PendingKind::Pair { partner: j as u32, partner_events: q.events };
+                match bracket_pair(a, b, &self.sim_box, now, &self.short, bound) {
+                    PairBracket::Beyond | PairBracket::Known(None) => {}
+                    PairBracket::Known(Some(t)) => {
+                        consider(&mut best, Pending { time: t.max(now), kind });
+                        bound = bound.min(best.time);
+                    }
+                    PairBracket::Between { lo, hi } if n_hits < HITS => {
+                        hits[n_hits] = (j as u32, lo.max(now));
+                        n_hits += 1;
+                        bound = bound.min(hi.max(now));
+                    }
+                    PairBracket::Between { .. } => {
+                        let t = predict_pair(a, b, &self.sim_box, now, &self.short).expect("a bracketed contact");
+                        consider(&mut best, Pending { time: t.max(now), kind });
+                        bound = bound.min(best.time);
+                    }
+                }
+            }
         }
-    }
-
-    /// Processes the next valid event and reports it; `None` when nothing can happen any
-    /// more (no event left in the queue).
-    pub fn step(&mut self) -> Option<Outcome<D>> {
-        self.compact_if_large();
-        loop {
-            let Queued(e) = self.queue.pop()?;
-            if !e.is_valid(&self.particles) {
-                self.counts.stale += 1;
+        // Pass 2: the exact time only where a bracket reaches down to the bound — usually
+        // one pair. A lower end equal to the bound may still tie and win, so it is kept.
+        for &(j, lo) in &hits[..n_hits] {
+            if lo > bound {
                 continue;
             }
-            self.time = e.time;
-            return Some(self.resolve(e));
+            let j = j as usize;
+            let q = &self.particles[j];
+            let (a, b) = if i < j { (p, q) } else { (q, p) };
+            let t = predict_pair(a, b, &self.sim_box, now, &self.short).expect("a bracketed contact");
+            let kind = PendingKind::Pair { partner: j as u32, partner_events: q.events };
+            consider(&mut best, Pending { time: t.max(now), kind });
+        }
+        self.queue.set(i, best);
+    }
+
+    /// Processes the next event and reports it; `None` when nothing can happen any more.
+    pub fn step(&mut self) -> Option<Outcome<D>> {
+        loop {
+            let (owner, &next) = self.queue.first();
+            if let Some(ts) = self.next_sample
+                && (ts < next.time || (ts == next.time && SAMPLE_RANK < next.key(owner as u32).0))
+            {
+                return Some(self.sample(ts));
+            }
+            let t = next.time;
+            match next.kind {
+                PendingKind::Nothing => return None,
+                PendingKind::Pair { partner, partner_events } => {
+                    let partner = partner as usize;
+                    if self.particles[partner].events != partner_events {
+                        // The partner changed course: a marker. Predict the owner again, from
+                        // the clock of the last real event (the marker is no event).
+                        self.counts.stale += 1;
+                        self.predict(owner, None);
+                        continue;
+                    }
+                    self.time = t;
+                    self.counts.pair += 1;
+                    let (i, j) = if owner < partner { (owner, partner) } else { (partner, owner) };
+                    let impulse = resolve_pair_event(&mut self.particles, i, j, &self.sim_box, t, self.restitution);
+                    self.predict(i, Some(j));
+                    self.predict(j, None);
+                    return Some(Outcome::Pair { i, j, impulse });
+                }
+                PendingKind::Wall { axis, upper } => {
+                    self.time = t;
+                    self.counts.wall += 1;
+                    let axis = axis as usize;
+                    let impulse = resolve_wall_event(&mut self.particles[owner], axis, upper, t);
+                    self.predict(owner, None);
+                    return Some(Outcome::Wall { i: owner, axis, upper, impulse });
+                }
+                PendingKind::Cell { axis, up } => {
+                    self.time = t;
+                    self.counts.cell += 1;
+                    self.cells.shift(owner, axis as usize, up);
+                    // Same velocity, new neighbours: predict again over the new cells.
+                    self.predict(owner, None);
+                    return Some(Outcome::Cell);
+                }
+            }
         }
     }
 
-    /// Applies a valid event at `self.time` and re-predicts.
-    fn resolve(&mut self, e: Event) -> Outcome<D> {
-        let t = self.time;
-        match e.kind {
-            EventKind::Pair { j, .. } => {
-                self.counts.pair += 1;
-                let i = e.i;
-                let impulse = resolve_pair_event(&mut self.particles, i, j, &self.sim_box, t, self.restitution);
-                self.predict(i, Some(j));
-                self.predict(j, None);
-                Outcome::Pair { i, j, impulse }
-            }
-            EventKind::Wall { axis, upper } => {
-                self.counts.wall += 1;
-                let impulse = resolve_wall_event(&mut self.particles[e.i], axis, upper, t);
-                self.predict(e.i, None);
-                Outcome::Wall { i: e.i, axis, upper, impulse }
-            }
-            EventKind::Cell { axis, up } => {
-                self.counts.cell += 1;
-                self.cells.shift(e.i, axis, up);
-                // Same counter: the pending pair and wall events of e.i stay valid; predict the
-                // new neighbours and the next crossing (duplicates become stale harmlessly).
-                self.predict(e.i, None);
-                Outcome::Cell
-            }
-            EventKind::Sample => {
-                self.counts.sample += 1;
-                // An interval below the resolution of the clock (t + dt = t) would sample at
-                // the same instant forever: sampling stops instead.
-                if let Some(dt) = self.sampling
-                    && t + dt > t
-                {
-                    self.push(Event { time: t + dt, i: usize::MAX, i_events: 0, kind: EventKind::Sample });
-                }
-                Outcome::Sample
-            }
-        }
+    /// The sampling instant `t` is reached.
+    fn sample(&mut self, t: f64) -> Outcome<D> {
+        self.time = t;
+        self.counts.sample += 1;
+        // An interval below the resolution of the clock (t + dt = t) would sample at the
+        // same instant forever: sampling stops instead.
+        self.next_sample = self.sampling.map(|dt| t + dt).filter(|&next| next > t);
+        Outcome::Sample
     }
 }
 
@@ -508,6 +576,9 @@ impl<const D: usize> Simulation<D> {
 fn validate<const D: usize>(particles: &[Particle<D>], sim_box: &SimBox<D>) -> Result<f64, SetupError> {
     if particles.is_empty() {
         return Err(SetupError::Empty);
+    }
+    if particles.len() >= u32::MAX as usize {
+        return Err(SetupError::TooMany { n: particles.len() });
     }
     let mut rmax: f64 = 0.0;
     for (index, p) in particles.iter().enumerate() {

@@ -159,9 +159,9 @@ impl std::error::Error for ContactError {}
 /// assert_eq!(contact_time(&a, &c), Ok(Contact::Never(Miss::NoRelativeMotion)));
 /// ```
 pub fn contact_time<const D: usize>(first: &Ball<D>, second: &Ball<D>) -> Result<Contact, ContactError> {
-    match filtered(first, second) {
-        Some(contact) => Ok(contact),
-        None => validated_exact(first, second),
+    match filtered::<D, false>(first, second, f64::INFINITY) {
+        Verdict::Decided(contact) => Ok(contact),
+        _ => validated_exact(first, second),
     }
 }
 
@@ -203,7 +203,105 @@ type Pair = (f64, f64);
 /// [`contact_time`] for inputs already known to be finite with non-negative radii.
 #[inline]
 pub fn contact_time_unchecked<const D: usize>(first: &Ball<D>, second: &Ball<D>) -> Contact {
-    filtered(first, second).unwrap_or_else(|| exact_full(first, second))
+    match filtered::<D, false>(first, second, f64::INFINITY) {
+        Verdict::Decided(contact) => contact,
+        _ => exact_full(first, second),
+    }
+}
+
+/// [`contact_time_unchecked`] for a caller that only wants contacts at or before `horizon`
+/// (the earliest event found so far, in an event-driven simulation).
+///
+/// Returns `None` only when the balls certainly do not touch at or before `horizon`: the
+/// exact contact time of the f64 inputs is later than `horizon`, or there is none.
+/// Otherwise it returns exactly `Some(contact_time_unchecked(first, second))` — which may
+/// itself be a `Never`, or a time after `horizon` when the cheap bound could not decide.
+///
+/// The test is a certified lower bound that costs a comparison: when the filter has
+/// certified `b < 0` and `c > 0`, then `√D ≤ −b` (as `D = b² − a·c ≤ b²`), so
+///
+/// `t = c / (−b + √D) ≥ c / (−2b)`,
+///
+/// and with the filter's error bounds `|b − b̃| ≤ β`, `|c − c̃| ≤ γ` the pair is rejected
+/// when `(c̃ − γ) > 2·horizon·(−b̃ + β)` holds with a further margin for the rounding of
+/// that comparison. The double-double root (the expensive part of a hit) is then never
+/// computed. The classification of what is returned stays exact.
+///
+/// ```
+/// use quadratic::{contact_time_within, Ball, Contact};
+/// let a = Ball { position: [0.0, 0.0], velocity: [1.0, 0.0], radius: 0.5 };
+/// let b = Ball { position: [5.0, 0.0], velocity: [-1.0, 0.0], radius: 0.5 };
+/// assert_eq!(contact_time_within(&a, &b, 1.0), None); // they touch at t = 2
+/// assert_eq!(contact_time_within(&a, &b, 2.0), Some(Contact::At(2.0)));
+/// ```
+#[inline]
+pub fn contact_time_within<const D: usize>(first: &Ball<D>, second: &Ball<D>, horizon: f64) -> Option<Contact> {
+    match filtered::<D, false>(first, second, horizon) {
+        Verdict::Decided(contact) => Some(contact),
+        Verdict::Beyond => None,
+        _ => Some(exact_full(first, second)),
+    }
+}
+
+/// A contact time known to lie in an interval, from [`contact_bracket`].
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Bracket {
+    /// Certainly no contact at or before the horizon (the exact time is later, or there is none).
+    Beyond,
+    /// The answer, exactly as [`contact_time_unchecked`] gives it.
+    Known(Contact),
+    /// A contact: [`contact_time_unchecked`] returns `At(t)` with `lo ≤ t ≤ hi`.
+    Between {
+        /// Lower end (≥ 0).
+        lo: f64,
+        /// Upper end.
+        hi: f64,
+    },
+}
+
+/// A cheap certified bracket of the contact time, for a caller that looks for the earliest of
+/// many contacts (an event-driven simulation predicting one particle against its neighbours):
+/// bracket them all, then evaluate [`contact_time_unchecked`] only for the contacts whose
+/// lower end does not exceed the smallest upper end — usually one.
+///
+/// The filter's f64 values `b̃`, `c̃`, `D̃` and their error bounds `β`, `γ`, `δ` give
+///
+/// `(c̃ − γ) / (−b̃ + β + √(D̃ + δ)) ≤ t ≤ (c̃ + γ) / (−b̃ − β + √(D̃ − δ))`
+///
+/// widened by 16 u for the rounding of these expressions and the one ulp of the returned
+/// time. Typical pairs get a bracket a few ulps wide at the cost of one square root and two
+/// divisions; the double-double root is left for the one pair that needs it. When the filter
+/// cannot decide, the exact path runs and the answer is [`Bracket::Known`]. A lower end
+/// later than `horizon` gives [`Bracket::Beyond`] (pass `+∞` for none).
+///
+/// ```
+/// use quadratic::{contact_bracket, Ball, Bracket};
+/// let a = Ball { position: [0.0, 0.0], velocity: [1.0, 0.0], radius: 0.5 };
+/// let b = Ball { position: [5.0, 0.0], velocity: [-1.0, 0.0], radius: 0.5 };
+/// let Bracket::Between { lo, hi } = contact_bracket(&a, &b, f64::INFINITY) else { panic!() };
+/// assert!(lo <= 2.0 && 2.0 <= hi && hi - lo < 1e-13);
+/// assert_eq!(contact_bracket(&a, &b, 1.0), Bracket::Beyond);
+/// ```
+#[inline]
+pub fn contact_bracket<const D: usize>(first: &Ball<D>, second: &Ball<D>, horizon: f64) -> Bracket {
+    match filtered::<D, true>(first, second, horizon) {
+        Verdict::Decided(contact) => Bracket::Known(contact),
+        Verdict::Beyond => Bracket::Beyond,
+        Verdict::Between(lo, hi) => Bracket::Between { lo, hi },
+        Verdict::Undecided => Bracket::Known(exact_full(first, second)),
+    }
+}
+
+/// What the filter concluded.
+enum Verdict {
+    /// The certified answer.
+    Decided(Contact),
+    /// Certainly no contact at or before the horizon.
+    Beyond,
+    /// The exact path must decide (or the input is invalid).
+    Undecided,
+    /// A contact whose time lies in `[lo, hi]` (only when asked for a bracket).
+    Between(f64, f64),
 }
 
 /// The exact (expansion) path alone, bypassing the filter: for the tests that prove both
@@ -304,8 +402,10 @@ const SLACK: f64 = 1e-300;
 /// Its bound is ~2⁻⁹⁸ of the scale below, so values above 2⁻¹⁸ of the scale qualify.
 const DD_ACCEPT: f64 = 1.0 / (1u64 << 18) as f64;
 
-/// The certified answer, or `None` when the exact path must decide (or the input is invalid:
-/// a NaN, an infinity or a negative radius fails the range screen and goes to the cold path).
+/// The certified answer, [`Verdict::Beyond`] when the contact is certainly later than
+/// `horizon` (pass `+∞` for none), or [`Verdict::Undecided`] when the exact path must decide
+/// (or the input is invalid: a NaN, an infinity or a negative radius fails the range screen
+/// and goes to the cold path).
 ///
 /// Notation: `Δrᵢ = hᵢ + lᵢ`, `Δvᵢ = gᵢ + mᵢ`, `σ = s + t`, where the heads are the rounded
 /// differences (sum) and the tails their rounding errors, `|lᵢ| ≤ u|hᵢ|` (and alike),
@@ -314,7 +414,7 @@ const DD_ACCEPT: f64 = 1.0 / (1u64 << 18) as f64;
 /// `s`, `|gᵢ|` must lie in `2^±150` (largest of each kind at least 2⁻¹⁵⁰), which keeps
 /// every product in range.
 #[inline(always)]
-fn filtered<const D: usize>(first: &Ball<D>, second: &Ball<D>) -> Option<Contact> {
+fn filtered<const D: usize, const BRACKET: bool>(first: &Ball<D>, second: &Ball<D>, horizon: f64) -> Verdict {
     const HI: f64 = pow2(150);
     const LO: f64 = pow2(-150);
     let mut h = [0.0; D];
@@ -332,7 +432,7 @@ fn filtered<const D: usize>(first: &Ball<D>, second: &Ball<D>) -> Option<Contact
         vmax = vmax.max(ag);
     }
     if !(ok && lmax >= LO && vmax >= LO) {
-        return None;
+        return Verdict::Undecided;
     }
     // --- b = ⟨Δv|Δr⟩ in f64. With P = Σ|hᵢgᵢ|: the FMA chain errs by ≤ D·u·P(1+Du) and
     // the dropped terms hᵢmᵢ + lᵢgᵢ + lᵢmᵢ by ≤ (2u + u²)P; (D + 4)·u·P covers both.
@@ -344,10 +444,10 @@ fn filtered<const D: usize>(first: &Ball<D>, second: &Ball<D>) -> Option<Contact
     }
     let bound_b = (D as f64 + 4.0) * U * p + SLACK;
     if b > bound_b {
-        return Some(Contact::Never(Miss::Receding));
+        return Verdict::Decided(Contact::Never(Miss::Receding));
     }
     if b >= -bound_b {
-        return None;
+        return Verdict::Undecided;
     }
     // --- c = |Δr|² − σ². With Q = Σhᵢ² + s²: chain error ≤ (D + 1)·u·Q, dropped
     // 2hᵢlᵢ + lᵢ² − 2st − t² ≤ (2u + u²)·Q.
@@ -359,10 +459,17 @@ fn filtered<const D: usize>(first: &Ball<D>, second: &Ball<D>) -> Option<Contact
     }
     let bound_c = (D as f64 + 5.0) * U * q + SLACK;
     if c < -bound_c {
-        return Some(Contact::Now);
+        return Verdict::Decided(Contact::Now);
     }
     if c <= bound_c {
-        return None;
+        return Verdict::Undecided;
+    }
+    // --- Horizon: t ≥ c/(−2b) (see `contact_time_within`). Each side of the comparison is
+    // off by at most 2u relatively after rounding (8u covers both), and the right side by
+    // at most 2⁻¹⁰⁷⁴ absolutely through underflow, which the added 2⁻¹⁰²² covers. With
+    // horizon = +∞ the right side is +∞ and nothing is rejected; a NaN rejects nothing.
+    if (c - bound_c) * (1.0 - 8.0 * U) > horizon * (2.0 * (bound_b - b)) + f64::MIN_POSITIVE {
+        return Verdict::Beyond;
     }
     // --- D = |Δv|²σ² − Σ_{i<j}(ΔrᵢΔvⱼ − ΔrⱼΔvᵢ)². With Xᵢⱼ = |hᵢgⱼ| + |hⱼgᵢ| and
     // A = a·s² + ΣXᵢⱼ²: each factor errs by a few u relative to its own scale (a by
@@ -385,10 +492,21 @@ fn filtered<const D: usize>(first: &Ball<D>, second: &Ball<D>) -> Option<Contact
     }
     let bound_d = 32.0 * U * scale + SLACK;
     if disc < -bound_d {
-        return Some(Contact::Never(Miss::PathsMiss));
+        return Verdict::Decided(Contact::Never(Miss::PathsMiss));
     }
     if disc <= bound_d {
-        return None;
+        return Verdict::Undecided;
+    }
+    if BRACKET {
+        // t = c/(−b + √D) with c ∈ [c̃ ∓ γ], −b ∈ [−b̃ ∓ β] (both > 0) and D ∈ [D̃ ∓ δ] (> 0):
+        // smallest numerator over largest denominator and vice versa. About eight roundings
+        // of at most u each (sqrt, sums, quotient), plus 1 ulp for the time actually returned:
+        // 16u on each side covers them, and MIN_POSITIVE any underflow.
+        let lo = (c - bound_c) / ((bound_b - b) + (disc + bound_d).sqrt());
+        let hi = (c + bound_c) / ((-b - bound_b) + (disc - bound_d).sqrt());
+        let lo = (lo * (1.0 - 16.0 * U) - f64::MIN_POSITIVE).max(0.0);
+        let hi = hi * (1.0 + 16.0 * U) + f64::MIN_POSITIVE;
+        return if lo > horizon { Verdict::Beyond } else { Verdict::Between(lo, hi) };
     }
     // --- All three signs certified: b < 0, c > 0, D > 0. Now the values, in double-double.
     // Each is an exact sum of TwoProd heads plus small terms accumulated in f64; its error is
@@ -396,7 +514,7 @@ fn filtered<const D: usize>(first: &Ball<D>, second: &Ball<D>) -> Option<Contact
     // ≤ u each, plus the TwoProd tails' own rounding), so accepting values ≥ 2⁻¹⁸·scale
     // bounds the relative error by 2⁻⁸⁰.
     if -b < DD_ACCEPT * p || c < DD_ACCEPT * q || disc < DD_ACCEPT * scale {
-        return None;
+        return Verdict::Undecided;
     }
     // The tails, now that they are needed: TwoSum heads equal the rounded differences above.
     let (dr, dv, sigma) = differences(first, second, 0, 0);
@@ -452,7 +570,7 @@ fn filtered<const D: usize>(first: &Ball<D>, second: &Ball<D>) -> Option<Contact
     };
     let den = neg_b.add(d_dd.sqrt());
     let t = c_dd.div(den);
-    Some(Contact::At(t.hi + t.lo))
+    Verdict::Decided(Contact::At(t.hi + t.lo))
 }
 
 /// A double-double accumulator: heads summed exactly by TwoSum, tails in plain f64.

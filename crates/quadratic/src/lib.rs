@@ -45,5 +45,8 @@ pub mod textbook;
 
 #[doc(hidden)]
 pub use contact::contact_time_exact_path;
-pub use contact::{Ball, Contact, ContactError, Field, Miss, contact_time, contact_time_unchecked};
+pub use contact::{
+    Ball, Bracket, Contact, ContactError, Field, Miss, contact_bracket, contact_time, contact_time_unchecked,
+    contact_time_within,
+};
 pub use roots::{Coefficient, Roots, SolveError, solve};

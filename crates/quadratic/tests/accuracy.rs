@@ -14,7 +14,8 @@ use common::oracle::{check_roots, class3, exact_contact};
 use common::runner;
 use proptest::prelude::*;
 use proptest::strategy::BoxedStrategy;
-use quadratic::{Ball, Contact, textbook};
+use proptest::test_runner::TestCaseError;
+use quadratic::{Ball, Bracket, Contact, textbook};
 use std::cell::RefCell;
 
 /// Cases per family. The contract is a worst-case claim, so more is better; 20 000 per
@@ -150,6 +151,91 @@ fn contact_time_contract_on_every_family_2d() {
 #[test]
 fn contact_time_contract_on_every_family_3d() {
     publish("Contact time (3D)", &score_contacts(contact_families_3d()));
+}
+
+/// `contact_time_within` and `contact_bracket` may drop a pair only when its exact contact
+/// time is later than the horizon; otherwise `contact_time_within` gives exactly
+/// `contact_time`'s answer, and `contact_bracket` either that answer or an interval that holds
+/// the time `contact_time` returns. Horizons sit at, one
+/// ulp either side of, and well before and after each contact time (and at 0, −1, ±∞).
+fn within_contract<const D: usize>(families: Vec<(&'static str, BoxedStrategy<(Ball<D>, Ball<D>)>)>) {
+    use common::families::nudge;
+    for (name, strategy) in families {
+        let (hits, dropped_early) = (RefCell::new(0usize), RefCell::new(0usize));
+        let (brackets, tight) = (RefCell::new(0usize), RefCell::new(0usize));
+        let result = runner(CASES / 4).run(&strategy, |(p, q)| {
+            let got = quadratic::contact_time(&p, &q).expect("valid inputs");
+            let exact = exact_contact(&p, &q);
+            let t = got.time().unwrap_or(1.0);
+            let horizons =
+                [t, nudge(t, -1), nudge(t, 1), 0.49 * t, 2.0 * t, 0.0, -1.0, f64::INFINITY, f64::NEG_INFINITY];
+            for (k, &h) in horizons.iter().enumerate() {
+                match quadratic::contact_time_within(&p, &q, h) {
+                    Some(c) => prop_assert_eq!(c, got, "{:?} {:?} horizon {:e}", p, q, h),
+                    None => {
+                        let later = match got {
+                            Contact::At(_) => exact.exceeds(h),
+                            Contact::Now => false,
+                            Contact::Never(_) => true,
+                        };
+                        prop_assert!(later, "{:?} {:?}: dropped at horizon {:e} but {:?}", p, q, h, got);
+                    }
+                }
+                match quadratic::contact_bracket(&p, &q, h) {
+                    Bracket::Known(c) => prop_assert_eq!(c, got, "{:?} {:?} horizon {:e}", p, q, h),
+                    Bracket::Beyond => {
+                        let later = match got {
+                            Contact::At(_) => exact.exceeds(h),
+                            Contact::Now => false,
+                            Contact::Never(_) => true,
+                        };
+                        prop_assert!(later, "{:?} {:?}: bracket beyond {:e} but {:?}", p, q, h, got);
+                    }
+                    Bracket::Between { lo, hi } => {
+                        let Contact::At(t) = got else {
+                            return Err(TestCaseError::fail(format!("{p:?} {q:?}: bracket for {got:?}")));
+                        };
+                        prop_assert!(lo <= t && t <= hi && lo <= h, "{:?} {:?}: {} not in [{}, {}]", p, q, t, lo, hi);
+                        if k == 7 {
+                            *brackets.borrow_mut() += 1;
+                            if hi - lo <= 1e-12 * hi {
+                                *tight.borrow_mut() += 1;
+                            }
+                        }
+                    }
+                }
+                if k == 3 && matches!(got, Contact::At(_)) {
+                    *hits.borrow_mut() += 1;
+                    if quadratic::contact_time_within(&p, &q, h).is_none() {
+                        *dropped_early.borrow_mut() += 1;
+                    }
+                }
+            }
+            Ok(())
+        });
+        if let Err(e) = result {
+            panic!("family '{name}': {e}");
+        }
+        // The bound c/(−2b) is at least half the contact time, so a horizon of 0.49·t is always
+        // beaten whenever the filter decides; on ordinary fluid pairs it decides nearly always.
+        if name.contains("dense-fluid") {
+            let (h, d) = (hits.into_inner(), dropped_early.into_inner());
+            assert!(h > 100 && d as f64 >= 0.95 * h as f64, "{name}: only {d} of {h} hits dropped at 0.49·t");
+            // And its brackets are narrow (relative width ≤ 1e-12) for nearly every hit.
+            let (b, t) = (brackets.into_inner(), tight.into_inner());
+            assert!(b as f64 >= 0.95 * h as f64 && t as f64 >= 0.95 * b as f64, "{name}: {t} of {b} brackets tight");
+        }
+    }
+}
+
+#[test]
+fn contact_time_within_drops_only_later_contacts_2d() {
+    within_contract(contact_families());
+}
+
+#[test]
+fn contact_time_within_drops_only_later_contacts_3d() {
+    within_contract(contact_families_3d());
 }
 
 /// The oracle itself must be able to fail: answers moved by 2 ulps, or misclassified,

@@ -280,6 +280,15 @@ impl ExactContact {
         }
         ulps_from_root(t, &self.b.neg(), -1, &self.disc, &self.a)
     }
+    /// Whether the exact contact time is later than `h` (only for `At`): with
+    /// t = (−b − √D)/a and a > 0, t > h ⇔ −b − a·h > √D ⇔ (−b − a·h > 0 and (−b − a·h)² > D).
+    pub fn exceeds(&self, h: f64) -> bool {
+        if h.is_infinite() || h.is_nan() {
+            return h == f64::NEG_INFINITY;
+        }
+        let x = self.b.neg().sub(&self.a.mul(&Dy::from_f64(h)));
+        x.sign() > 0 && x.mul(&x).sub(&self.disc).sign() > 0
+    }
     /// The exact contact time, correctly rounded (for the edge-case table).
     pub fn time_rounded(&self) -> f64 {
         let root = self.disc.sqrt_within(self.disc.log2() / 2 - 200);
