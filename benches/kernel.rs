@@ -8,11 +8,13 @@
 //!   extreme scales.
 //!
 //! `robust` is `quadratic::contact_time` / `quadratic::solve`, `textbook` the seed's formula,
-//! `exact-path` the expansion fallback alone (what every pair would cost without the filter).
+//! `exact-path` the expansion fallback alone (what every pair would cost without the filter),
+//! `bracket` the certified interval `quadratic::contact_bracket` that the engine computes for
+//! every neighbour before it evaluates exactly the one or two pairs that can come first.
 //! Reported per batch; divide by the batch size (printed as throughput) for the cost per call.
 
 use criterion::{Criterion, Throughput, criterion_group, criterion_main};
-use quadratic::{Ball, contact_time, contact_time_exact_path, solve, textbook};
+use quadratic::{Ball, Bracket, contact_bracket, contact_time, contact_time_exact_path, solve, textbook};
 use rand::rngs::Xoshiro256PlusPlus;
 use rand::{RngExt, SeedableRng};
 use rand_distr::{Distribution, StandardNormal};
@@ -94,6 +96,19 @@ fn contact(c: &mut Criterion) {
                 let mut n = 0.0;
                 for (p, q) in pairs.iter() {
                     n += textbook::contact_time(black_box(p), black_box(q)).time().unwrap_or(-1.0);
+                }
+                n
+            })
+        });
+        group.bench_function("bracket", |b| {
+            b.iter(|| {
+                let mut n = 0.0;
+                for (p, q) in pairs.iter() {
+                    n += match contact_bracket(black_box(p), black_box(q), f64::INFINITY) {
+                        Bracket::Between { lo, .. } => lo,
+                        Bracket::Known(c) => c.time().unwrap_or(-1.0),
+                        Bracket::Beyond => -2.0,
+                    };
                 }
                 n
             })

@@ -192,6 +192,14 @@ pub struct OverlapAudit {
 /// particle rarely has more than a handful of approaching neighbours).
 const HITS: usize = 32;
 
+/// Neighbours gathered per prediction before the search in large systems (more: a direct walk).
+const NEAR: usize = 64;
+
+/// From this many particles on, the records no longer fit in the caches and the neighbours'
+/// records are gathered before the search (measured at η = 0.65, medians of three:
+/// N = 10⁶ 0.287 → 0.314·10⁶ collisions/s with gathering; N = 10⁴ 1.007 → 0.934, so not there).
+const GATHER_FROM: usize = 100_000;
+
 /// An event-driven simulation of hard disks (`D = 2`) or spheres.
 #[derive(Clone, Debug)]
 pub struct Simulation<const D: usize> {
@@ -205,6 +213,8 @@ pub struct Simulation<const D: usize> {
     counts: EventCounts,
     sampling: Option<f64>,
     next_sample: Option<f64>,
+    /// Gather neighbours before the search (large systems; see [`GATHER_FROM`]).
+    gather: bool,
 }
 
 /// The saved state of a [`Simulation`]: enough to continue bit-identically.
@@ -244,7 +254,9 @@ impl<const D: usize> Simulation<D> {
             counts: EventCounts::default(),
             sampling: None,
             next_sample: None,
+            gather: false,
         };
+        sim.gather = sim.particles.len() >= GATHER_FROM;
         if let Some(audit) = sim.overlap_beyond(0.0) {
             let (i, j) = audit.at.expect("an overlap has a place");
             if i == j {
@@ -310,6 +322,7 @@ impl<const D: usize> Simulation<D> {
             counts: state.counts,
             sampling: state.sampling,
             next_sample: state.next_sample,
+            gather: n >= GATHER_FROM,
         })
     }
 
@@ -467,32 +480,63 @@ impl<const D: usize> Simulation<D> {
         let mut bound = best.time;
         let mut hits = [(0u32, 0.0f64); HITS];
         let mut n_hits = 0;
-        let around = self.cells.around(i);
-        for &c in around.as_slice() {
-            for j in self.cells.members(c) {
-                let j = j as usize;
-                if j == i || j == skip {
-                    continue;
+        let particles = &self.particles;
+        let (sim_box, short) = (&self.sim_box, &self.short);
+        let mut visit = |j: usize| {
+            let q = &particles[j];
+            let (a, b) = if i < j { (p, q) } else { (q, p) };
+            let kind = PendingKind::Pair { partner: j as u32, partner_events: q.events };
+            match bracket_pair(a, b, sim_box, now, short, bound) {
+                PairBracket::Beyond | PairBracket::Known(None) => {}
+                PairBracket::Known(Some(t)) => {
+                    consider(&mut best, Pending { time: t.max(now), kind });
+                    bound = bound.min(best.time);
                 }
-                let q = &self.particles[j];
-                let (a, b) = if i < j { (p, q) } else { (q, p) };
-                let kind = PendingKind::Pair { partner: j as u32, partner_events: q.events };
-                match bracket_pair(a, b, &self.sim_box, now, &self.short, bound) {
-                    PairBracket::Beyond | PairBracket::Known(None) => {}
-                    PairBracket::Known(Some(t)) => {
-                        consider(&mut best, Pending { time: t.max(now), kind });
-                        bound = bound.min(best.time);
+                PairBracket::Between { lo, hi } if n_hits < HITS => {
+                    hits[n_hits] = (j as u32, lo.max(now));
+                    n_hits += 1;
+                    bound = bound.min(hi.max(now));
+                }
+                PairBracket::Between { .. } => {
+                    let t = predict_pair(a, b, sim_box, now, short).expect("a bracketed contact");
+                    consider(&mut best, Pending { time: t.max(now), kind });
+                    bound = bound.min(best.time);
+                }
+            }
+        };
+        let mut near = [0u32; NEAR];
+        let mut n_near = 0;
+        if !self.gather {
+            // Small systems live in cache: walk the cell lists directly.
+            for &c in self.cells.around(i).as_slice() {
+                for j in self.cells.members(c) {
+                    let j = j as usize;
+                    if j != i && j != skip {
+                        visit(j);
                     }
-                    PairBracket::Between { lo, hi } if n_hits < HITS => {
-                        hits[n_hits] = (j as u32, lo.max(now));
-                        n_hits += 1;
-                        bound = bound.min(hi.max(now));
-                    }
-                    PairBracket::Between { .. } => {
-                        let t = predict_pair(a, b, &self.sim_box, now, &self.short).expect("a bracketed contact");
-                        consider(&mut best, Pending { time: t.max(now), kind });
-                        bound = bound.min(best.time);
-                    }
+                }
+            }
+        } else if self.cells.neighbours(i).filter(|&j| j != i && j != skip).all(|j| {
+            // Large systems: gather the neighbours first and touch their records together
+            // (independent loads, issued at once) so that the search finds them in cache,
+            // rather than one cell-list hop and one miss at a time between kernel calls.
+            let room = n_near < NEAR;
+            if room {
+                near[n_near] = j as u32;
+                n_near += 1;
+            }
+            room
+        }) {
+            let t_max = near[..n_near].iter().fold(f64::NEG_INFINITY, |m, &j| m.max(particles[j as usize].time));
+            std::hint::black_box(t_max);
+            for &j in &near[..n_near] {
+                visit(j as usize);
+            }
+        } else {
+            // More than NEAR neighbours (only tiny disks among large ones): walk them all.
+            for j in self.cells.neighbours(i) {
+                if j != i && j != skip {
+                    visit(j);
                 }
             }
         }
@@ -607,4 +651,72 @@ fn validate<const D: usize>(particles: &[Particle<D>], sim_box: &SimBox<D>) -> R
         }
     }
     Ok(reach)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A jittered grid of `side²` disks of radius 0.1 at spacing 0.25 (η ≈ 0.5), with
+    /// pseudo-random velocities; with `big`, one disk of radius 1 in the middle (the small
+    /// ones it would overlap removed), which makes the cells two wide, so that a prediction
+    /// sees far more than NEAR neighbours.
+    fn system(side: usize, big: bool) -> Simulation<2> {
+        let mut state = 0x9e37_79b9_7f4a_7c15u64;
+        let mut unit = move || {
+            state ^= state << 13;
+            state ^= state >> 7;
+            state ^= state << 17;
+            (state >> 11) as f64 / (1u64 << 53) as f64 - 0.5
+        };
+        let (spacing, l) = (0.25, side as f64 * 0.25);
+        let centre = SVector::from([l / 2.0, l / 2.0]);
+        let disk = |position, radius: f64, velocity| Particle {
+            position,
+            velocity,
+            time: 0.0,
+            radius,
+            mass: radius * radius,
+            species: 0,
+            events: 0,
+        };
+        let mut particles: Vec<Particle<2>> = Vec::new();
+        if big {
+            particles.push(disk(centre, 1.0, SVector::from([0.3, -0.2])));
+        }
+        for k in 0..side * side {
+            let (x, y) = ((k % side) as f64, (k / side) as f64);
+            let position = SVector::from([(x + 0.5 + 0.1 * unit()) * spacing, (y + 0.5 + 0.1 * unit()) * spacing]);
+            let velocity = SVector::from([unit(), unit()]);
+            if !big || (position - centre).norm() > 1.15 {
+                particles.push(disk(position, 0.1, velocity));
+            }
+        }
+        Simulation::new(particles, SimBox { lengths: SVector::from([l, l]), boundary: [Boundary::Periodic; 2] })
+            .expect("a valid system")
+    }
+
+    /// Gathering neighbours (large systems), spilling past NEAR of them, and walking the
+    /// cell lists directly must give the same events bit for bit: only the order in which
+    /// neighbours are searched differs, and the result is the minimum in a total order.
+    #[test]
+    fn gathered_and_direct_searches_give_identical_events() {
+        for big in [false, true] {
+            let direct = system(40, big);
+            let mut gathered = direct.clone();
+            gathered.gather = true;
+            // Re-predict everything with gathering, as if it had been on from the start.
+            for i in 0..gathered.particles.len() {
+                gathered.predict(i, None);
+            }
+            let (mut direct, mut gathered) = (direct, gathered);
+            for _ in 0..20_000 {
+                let (a, b) = (direct.step(), gathered.step());
+                assert_eq!(a, b);
+                assert_eq!(direct.time().to_bits(), gathered.time().to_bits());
+            }
+            assert_eq!(direct.particles(), gathered.particles());
+            assert!(direct.counts().pair > 10_000, "{:?}", direct.counts());
+        }
+    }
 }

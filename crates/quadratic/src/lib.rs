@@ -9,6 +9,10 @@
 //!   first touch while approaching, as a [`Contact`] (never — and why —, now, or at `t`).
 //!   The never/now/at classification is exact for the f64 inputs and `t` is within one
 //!   ulp of the exact contact time of those inputs — not of rounded `a`, `b`, `c`.
+//! * [`contact_bracket`] and [`contact_time_within`] serve a search for the earliest of many
+//!   contacts: a certified interval for the time (or "later than the horizon") from the f64
+//!   filter alone, so that only the one or two candidates that can come first pay for the
+//!   double-double root.
 //! * [`exact`] holds the error-free building blocks (TwoSum, FMA TwoProd, Shewchuk
 //!   expansions, double-double); [`hex`] reads and writes C99 hex floats; [`textbook`]
 //!   is the seed's naive formula, kept only for comparison.
