@@ -145,6 +145,15 @@ pub fn predict_pair_within<const D: usize>(
     short: &[bool; D],
     horizon: f64,
 ) -> Option<f64> {
+    let absolute = |contact: Contact, t0: f64| match contact {
+        Contact::Never(_) => None,
+        Contact::Now => Some(t0),
+        Contact::At(dt) => Some(t0 + dt),
+    };
+    if !short.iter().any(|&s| s) {
+        let (a, b, t0) = pair_balls(pi, pj, sim_box, now);
+        return absolute(contact_time_within(&a, &b, relative_horizon(horizon, t0))?, t0);
+    }
     // Image counts (integers); a shift is always formed as one product count·L, so the same
     // image gives the same bits however it was reached.
     let base = sim_box.minimum_image_count(&(pj.position_at(now) - pi.position_at(now)));
@@ -154,15 +163,8 @@ pub fn predict_pair_within<const D: usize>(
     let a = Ball { position: ri.into(), velocity: pi.velocity.into(), radius: pi.radius };
     let earliest = |shift: &SVector<f64, D>| {
         let b = Ball { position: (rj + shift).into(), velocity: pj.velocity.into(), radius: pj.radius };
-        match contact_time_within(&a, &b, h)? {
-            Contact::Never(_) => None,
-            Contact::Now => Some(t0),
-            Contact::At(dt) => Some(t0 + dt),
-        }
+        absolute(contact_time_within(&a, &b, h)?, t0)
     };
-    if !short.iter().any(|&s| s) {
-        return earliest(&base.component_mul(&sim_box.lengths));
-    }
     // Every combination of −1, 0, +1 box lengths along the short axes.
     let mut best: Option<f64> = None;
     let mut offset = [0i32; D];
@@ -229,9 +231,27 @@ pub fn bracket_pair<const D: usize>(
             known => PairBracket::Known(known),
         };
     }
+    let (a, b, t0) = pair_balls(pi, pj, sim_box, now);
+    match contact_bracket(&a, &b, relative_horizon(horizon, t0)) {
+        Bracket::Beyond => PairBracket::Beyond,
+        Bracket::Known(Contact::Never(_)) => PairBracket::Known(None),
+        Bracket::Known(Contact::Now) => PairBracket::Known(Some(t0)),
+        Bracket::Known(Contact::At(dt)) => PairBracket::Known(Some(t0 + dt)),
+        Bracket::Between { lo, hi } => PairBracket::Between { lo: t0 + lo, hi: t0 + hi },
+    }
+}
+
+/// The two balls the kernel is given for a pair when no axis is short: positions at `t0`,
+/// the later of the two update times, with `j` at its image nearest to `i` at `now`; and `t0`.
+#[inline]
+fn pair_balls<const D: usize>(
+    pi: &Particle<D>,
+    pj: &Particle<D>,
+    sim_box: &SimBox<D>,
+    now: f64,
+) -> (Ball<D>, Ball<D>, f64) {
     let base = sim_box.minimum_image_count(&(pj.position_at(now) - pi.position_at(now)));
     let t0 = pi.time.max(pj.time);
-    let h = relative_horizon(horizon, t0);
     let (ri, rj) = (pi.position_at(t0), pj.position_at(t0));
     let a = Ball { position: ri.into(), velocity: pi.velocity.into(), radius: pi.radius };
     let b = Ball {
@@ -239,13 +259,7 @@ pub fn bracket_pair<const D: usize>(
         velocity: pj.velocity.into(),
         radius: pj.radius,
     };
-    match contact_bracket(&a, &b, h) {
-        Bracket::Beyond => PairBracket::Beyond,
-        Bracket::Known(Contact::Never(_)) => PairBracket::Known(None),
-        Bracket::Known(Contact::Now) => PairBracket::Known(Some(t0)),
-        Bracket::Known(Contact::At(dt)) => PairBracket::Known(Some(t0 + dt)),
-        Bracket::Between { lo, hi } => PairBracket::Between { lo: t0 + lo, hi: t0 + hi },
-    }
+    (a, b, t0)
 }
 
 /// The horizon relative to `t0`, widened so that a dropped contact (exact Δt > h) rounds to

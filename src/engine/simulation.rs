@@ -57,7 +57,7 @@ pub enum Outcome<const D: usize> {
     Sample,
 }
 
-/// Counts of processed events by kind, and of stale events discarded.
+/// Counts of processed events by kind, and of re-prediction markers (`stale`).
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
 pub struct EventCounts {
     /// Pair collisions.
