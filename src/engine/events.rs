@@ -65,18 +65,6 @@ pub struct Event {
 }
 
 impl Event {
-    /// Whether the event still holds: every particle it involves has the event count it had
-    /// when the event was predicted (samples are always valid).
-    pub fn is_valid<const D: usize>(&self, particles: &[Particle<D>]) -> bool {
-        match self.kind {
-            EventKind::Sample => true,
-            EventKind::Pair { j, j_events } => {
-                particles[self.i].events == self.i_events && particles[j].events == j_events
-            }
-            _ => particles[self.i].events == self.i_events,
-        }
-    }
-
     /// The total order of events: by time, then pair < wall < cell < sample, then by the
     /// particles and axes involved. No two distinct live events compare equal, so the
     /// sequence of events never depends on the order in which they were pushed.
@@ -399,29 +387,5 @@ impl Pending {
     #[inline]
     pub fn before(&self, owner: u32, other: &Pending, other_owner: u32) -> bool {
         self.time < other.time || (self.time == other.time && self.key(owner) < other.key(other_owner))
-    }
-
-    /// The event in the public form, for the owner `owner` whose counter is `owner_events`.
-    pub fn event(&self, owner: u32, owner_events: u64) -> Option<Event> {
-        let i = owner as usize;
-        let kind = match self.kind {
-            PendingKind::Nothing => return None,
-            PendingKind::Pair { partner, partner_events } => {
-                let (lo, lo_events, hi, hi_events) = if owner < partner {
-                    (owner, owner_events, partner, partner_events)
-                } else {
-                    (partner, partner_events, owner, owner_events)
-                };
-                return Some(Event {
-                    time: self.time,
-                    i: lo as usize,
-                    i_events: lo_events,
-                    kind: EventKind::Pair { j: hi as usize, j_events: hi_events },
-                });
-            }
-            PendingKind::Wall { axis, upper } => EventKind::Wall { axis: axis as usize, upper },
-            PendingKind::Cell { axis, up } => EventKind::Cell { axis: axis as usize, up },
-        };
-        Some(Event { time: self.time, i, i_events: owner_events, kind })
     }
 }
