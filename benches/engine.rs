@@ -13,6 +13,8 @@ use collide::engine::init::{Placement, Species, Velocities, box_for_packing_frac
 use collide::engine::queue::EventQueue;
 use collide::engine::{Boundary, Simulation};
 use criterion::{BenchmarkId, Criterion, Throughput, criterion_group, criterion_main};
+use rand::rngs::Xoshiro256PlusPlus;
+use rand::{RngExt, SeedableRng};
 use std::hint::black_box;
 use std::time::{Duration, Instant};
 
@@ -78,13 +80,8 @@ fn parts(c: &mut Criterion) {
     });
     // A queue of 10⁴ events; each update moves the earliest one later by a pseudo-random step.
     let wall = |time| Pending { time, kind: PendingKind::Wall { axis: 0, upper: true } };
-    let mut state = 0x2545_f491_4f6c_dd1du64;
-    let mut next = move || {
-        state ^= state << 13;
-        state ^= state >> 7;
-        state ^= state << 17;
-        (state % 100_000) as f64
-    };
+    let mut rng = Xoshiro256PlusPlus::seed_from_u64(3);
+    let mut next = move || rng.random_range(0.0..100_000.0f64).floor();
     let mut queue = EventQueue::new((0..10_000).map(|_| wall(next())).collect());
     group.throughput(Throughput::Elements(1));
     group.bench_function("queue_set_root", |b| {

@@ -135,6 +135,8 @@ impl<const D: usize> Particle<D> {
 #[cfg(test)]
 mod tests {
     use super::image_count;
+    use rand::rngs::Xoshiro256PlusPlus;
+    use rand::{RngExt, SeedableRng};
 
     /// The comparisons give `−round(x/l)` bit for bit: at and one or two ulps around every
     /// threshold (0.49, ½, 0.51, 1.49, 3/2 box lengths), at zeros of both signs, and at many
@@ -142,13 +144,7 @@ mod tests {
     #[test]
     fn image_count_is_minus_round_of_the_quotient() {
         let step = |x: f64, k: i64| f64::from_bits((x.to_bits() as i64 + k) as u64);
-        let mut state = 0x9e37_79b9_7f4a_7c15u64;
-        let mut unit = move || {
-            state ^= state << 13;
-            state ^= state >> 7;
-            state ^= state << 17;
-            (state >> 11) as f64 / (1u64 << 53) as f64
-        };
+        let mut rng = Xoshiro256PlusPlus::seed_from_u64(11);
         let mut checked = 0;
         for &l in &[1.0, 3.0, 7.3, 40.0, 109.87, 1e-300, 1e300, 0.1 + 0.2] {
             let mut xs = vec![0.0, -0.0, l, -l];
@@ -160,7 +156,7 @@ mod tests {
                 }
             }
             for _ in 0..20_000 {
-                let x = (unit() - 0.5) * 4.0 * l;
+                let x: f64 = rng.random_range(-2.0..2.0) * l;
                 xs.push(x);
             }
             for x in xs {

@@ -116,6 +116,8 @@ impl EventQueue {
 mod tests {
     use super::*;
     use crate::engine::events::PendingKind;
+    use rand::rngs::Xoshiro256PlusPlus;
+    use rand::{RngExt, SeedableRng};
 
     fn wall(time: f64) -> Pending {
         Pending { time, kind: PendingKind::Wall { axis: 0, upper: true } }
@@ -125,19 +127,13 @@ mod tests {
     /// are and are not powers of two; ties are broken by the owner.
     #[test]
     fn first_is_the_minimum_in_the_total_order() {
-        let mut state = 0x2545_f491_4f6c_dd1du64;
-        let mut next = || {
-            state ^= state << 13;
-            state ^= state >> 7;
-            state ^= state << 17;
-            state
-        };
+        let mut rng = Xoshiro256PlusPlus::seed_from_u64(5);
         for n in [1usize, 2, 3, 5, 8, 13, 100] {
             let mut queue = EventQueue::new((0..n).map(|_| Pending::NOTHING).collect());
             for _ in 0..2000 {
-                let owner = (next() % n as u64) as usize;
+                let owner = rng.random_range(0..n);
                 // Few distinct times, so that ties are common; sometimes nothing.
-                let r = next() % 9;
+                let r: u32 = rng.random_range(0..9);
                 let event = if r == 8 { Pending::NOTHING } else { wall(r as f64) };
                 queue.set(owner, event);
                 let (got, _) = queue.first();

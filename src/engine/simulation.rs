@@ -656,19 +656,16 @@ fn validate<const D: usize>(particles: &[Particle<D>], sim_box: &SimBox<D>) -> R
 #[cfg(test)]
 mod tests {
     use super::*;
+    use rand::rngs::Xoshiro256PlusPlus;
+    use rand::{RngExt, SeedableRng};
 
     /// A jittered grid of `side²` disks of radius 0.1 at spacing 0.25 (η ≈ 0.5), with
     /// pseudo-random velocities; with `big`, one disk of radius 1 in the middle (the small
     /// ones it would overlap removed), which makes the cells two wide, so that a prediction
     /// sees far more than NEAR neighbours.
     fn system(side: usize, big: bool) -> Simulation<2> {
-        let mut state = 0x9e37_79b9_7f4a_7c15u64;
-        let mut unit = move || {
-            state ^= state << 13;
-            state ^= state >> 7;
-            state ^= state << 17;
-            (state >> 11) as f64 / (1u64 << 53) as f64 - 0.5
-        };
+        let mut rng = Xoshiro256PlusPlus::seed_from_u64(7);
+        let mut unit = move || rng.random_range(-0.5..0.5);
         let (spacing, l) = (0.25, side as f64 * 0.25);
         let centre = SVector::from([l / 2.0, l / 2.0]);
         let disk = |position, radius: f64, velocity| Particle {
