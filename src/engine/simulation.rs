@@ -485,24 +485,21 @@ impl<const D: usize> Simulation<D> {
         let mut visit = |j: usize| {
             let q = &particles[j];
             let (a, b) = if i < j { (p, q) } else { (q, p) };
-            let kind = PendingKind::Pair { partner: j as u32, partner_events: q.events };
-            match bracket_pair(a, b, sim_box, now, short, bound) {
-                PairBracket::Beyond | PairBracket::Known(None) => {}
-                PairBracket::Known(Some(t)) => {
-                    consider(&mut best, Pending { time: t.max(now), kind });
-                    bound = bound.min(best.time);
-                }
+            let exact = match bracket_pair(a, b, sim_box, now, short, bound) {
+                PairBracket::Beyond | PairBracket::Known(None) => return,
+                PairBracket::Known(Some(t)) => t,
                 PairBracket::Between { lo, hi } if n_hits < HITS => {
                     hits[n_hits] = (j as u32, lo.max(now));
                     n_hits += 1;
                     bound = bound.min(hi.max(now));
+                    return;
                 }
-                PairBracket::Between { .. } => {
-                    let t = predict_pair(a, b, sim_box, now, short).expect("a bracketed contact");
-                    consider(&mut best, Pending { time: t.max(now), kind });
-                    bound = bound.min(best.time);
-                }
-            }
+                // No room left to defer it: evaluate it now.
+                PairBracket::Between { .. } => predict_pair(a, b, sim_box, now, short).expect("a bracketed contact"),
+            };
+            let kind = PendingKind::Pair { partner: j as u32, partner_events: q.events };
+            consider(&mut best, Pending { time: exact.max(now), kind });
+            bound = bound.min(best.time);
         };
         let mut near = [0u32; NEAR];
         let mut n_near = 0;
