@@ -183,12 +183,20 @@ impl<const D: usize> Cells<D> {
         let mut axis_len = [0usize; D];
         for a in 0..D {
             let n = self.counts[a] as i64;
+            // One division per axis; the neighbours wrap by comparison.
+            let centre = m[a].rem_euclid(n);
             for o in -1..=1 {
-                let x = m[a] + o;
-                if self.boundary[a] == Boundary::Wall && !(0..n).contains(&x) {
+                if self.boundary[a] == Boundary::Wall && !(0..n).contains(&(m[a] + o)) {
                     continue;
                 }
-                let w = x.rem_euclid(n) as usize;
+                let x = centre + o;
+                let w = if x < 0 {
+                    x + n
+                } else if x >= n {
+                    x - n
+                } else {
+                    x
+                } as usize;
                 if !axis_coords[a][..axis_len[a]].contains(&w) {
                     axis_coords[a][axis_len[a]] = w;
                     axis_len[a] += 1;
@@ -220,6 +228,25 @@ impl<const D: usize> Cells<D> {
     #[inline]
     pub fn members(&self, c: u32) -> Members<'_> {
         Members { next: &self.next, at: self.head[c as usize] }
+    }
+
+    /// Writes the particles in the cells around particle `i`, except `i` and `skip`, into
+    /// `out` and returns how many — or `None` as soon as they do not fit.
+    #[inline]
+    pub fn gather(&self, i: usize, skip: usize, out: &mut [u32]) -> Option<usize> {
+        let around = self.around(i);
+        let mut len = 0;
+        for &c in around.as_slice() {
+            let mut j = self.head[c as usize];
+            while j != NONE {
+                if j as usize != i && j as usize != skip {
+                    *out.get_mut(len)? = j;
+                    len += 1;
+                }
+                j = self.next[j as usize];
+            }
+        }
+        Some(len)
     }
 
     /// Every particle in the cells around particle `i` (itself included).

@@ -19,8 +19,8 @@
 use super::cells::Cells;
 use super::collision::{Impulse, Restitution};
 use super::events::{
-    PairBracket, Pending, PendingKind, SAMPLE_RANK, bracket_pair, pair_positions, predict_pair, predict_wall,
-    resolve_pair_event, resolve_wall_event, short_axes,
+    LANES, PairBracket, Pending, PendingKind, SAMPLE_RANK, bracket_neighbours, bracket_pair, pair_positions,
+    predict_pair, predict_wall, resolve_pair_event, resolve_wall_event, short_axes,
 };
 use super::geometry::{Boundary, Particle, SimBox};
 use super::queue::EventQueue;
@@ -192,13 +192,8 @@ pub struct OverlapAudit {
 /// particle rarely has more than a handful of approaching neighbours).
 const HITS: usize = 32;
 
-/// Neighbours gathered per prediction before the search in large systems (more: a direct walk).
+/// Neighbours gathered per prediction for the batch search (more: the scalar search).
 const NEAR: usize = 64;
-
-/// From this many particles on, the records no longer fit in the caches and the neighbours'
-/// records are gathered before the search (measured at η = 0.65, medians of three:
-/// N = 10⁶ 0.287 → 0.314·10⁶ collisions/s with gathering; N = 10⁴ 1.007 → 0.934, so not there).
-const GATHER_FROM: usize = 100_000;
 
 /// An event-driven simulation of hard disks (`D = 2`) or spheres.
 #[derive(Clone, Debug)]
@@ -213,8 +208,9 @@ pub struct Simulation<const D: usize> {
     counts: EventCounts,
     sampling: Option<f64>,
     next_sample: Option<f64>,
-    /// Gather neighbours before the search (large systems; see [`GATHER_FROM`]).
-    gather: bool,
+    /// Search pairs with the batch kernel ([`bracket_neighbours`]); false when an axis is
+    /// short (several images per pair) — and in the test that compares both searches.
+    batch: bool,
 }
 
 /// The saved state of a [`Simulation`]: enough to continue bit-identically.
@@ -254,9 +250,9 @@ impl<const D: usize> Simulation<D> {
             counts: EventCounts::default(),
             sampling: None,
             next_sample: None,
-            gather: false,
+            batch: false,
         };
-        sim.gather = sim.particles.len() >= GATHER_FROM;
+        sim.batch = !sim.short.contains(&true);
         if let Some(audit) = sim.overlap_beyond(0.0) {
             let (i, j) = audit.at.expect("an overlap has a place");
             if i == j {
@@ -311,10 +307,12 @@ impl<const D: usize> Simulation<D> {
                 m
             })
             .collect();
+        let short = short_axes(&sim_box, reach);
         Ok(Simulation {
             cells: Cells::from_coords(&sim_box, reach, coords),
             particles: state.particles,
-            short: short_axes(&sim_box, reach),
+            batch: !short.contains(&true),
+            short,
             sim_box,
             queue: EventQueue::new(state.pending),
             time: state.time,
@@ -322,7 +320,6 @@ impl<const D: usize> Simulation<D> {
             counts: state.counts,
             sampling: state.sampling,
             next_sample: state.next_sample,
-            gather: n >= GATHER_FROM,
         })
     }
 
@@ -474,71 +471,92 @@ impl<const D: usize> Simulation<D> {
             let t = (p.time + dt).max(now);
             consider(&mut best, Pending { time: t, kind: PendingKind::Cell { axis: axis as u8, up } });
         }
+        let skip = except.unwrap_or(i);
+        let mut near = [0u32; NEAR];
+        let gathered = if self.batch { self.cells.gather(i, skip, &mut near) } else { None };
+        if let Some(n_near) = gathered {
+            // Pass 1: bracket the neighbours LANES at a time (branch-free); `bound` is the
+            // earliest time some candidate is certain to reach.
+            let mut lo = [f64::INFINITY; NEAR];
+            let mut hi = [f64::INFINITY; NEAR];
+            for (c, js) in near[..n_near].chunks(LANES).enumerate() {
+                let range = c * LANES..(c + 1) * LANES;
+                let (lo, hi) = (&mut lo[range.clone()], &mut hi[range]);
+                let (lo, hi) = (lo.try_into().expect("LANES wide"), hi.try_into().expect("LANES wide"));
+                bracket_neighbours(&self.particles, i, js, &self.sim_box, now, lo, hi);
+            }
+            let bound = hi[..n_near].iter().fold(best.time, |m, &h| m.min(h));
+            // Pass 2: the candidates whose bracket reaches down to the bound — usually one.
+            // A lower end equal to the bound may still tie and win, so it is kept. Where both
+            // ends of the bracket round to the same absolute time, that is the event's time
+            // to the bit (t0 ⊕ lo ≤ t0 ⊕ Δt ≤ t0 ⊕ hi, rounding being monotone): the clock's
+            // ulp is much coarser than a bracket a few ulps of Δt wide, so the double-double
+            // root is rarely needed at all.
+            for ((&j, &lo), &hi) in near[..n_near].iter().zip(&lo[..n_near]).zip(&hi[..n_near]) {
+                if lo <= bound {
+                    let j = j as usize;
+                    let q = &self.particles[j];
+                    let t = if lo == hi && lo < f64::INFINITY {
+                        Some(lo)
+                    } else {
+                        let (a, b) = if i < j { (p, q) } else { (q, p) };
+                        predict_pair(a, b, &self.sim_box, now, &self.short).map(|t| t.max(now))
+                    };
+                    if let Some(t) = t {
+                        let kind = PendingKind::Pair { partner: j as u32, partner_events: q.events };
+                        consider(&mut best, Pending { time: t, kind });
+                    }
+                }
+            }
+        } else {
+            self.predict_scalar(i, skip, &mut best);
+        }
+        self.queue.set(i, best);
+    }
+
+    /// The pair search of [`predict`](Self::predict) one pair at a time, for the cases the
+    /// batch cannot take: short periodic axes (several images per pair) and more than
+    /// [`NEAR`] neighbours (tiny disks among large ones). Same events.
+    #[cold]
+    fn predict_scalar(&self, i: usize, skip: usize, best: &mut Pending) {
+        let p = &self.particles[i];
+        let now = self.time;
+        let owner = i as u32;
+        let consider = |best: &mut Pending, e: Pending| {
+            if e.before(owner, best, owner) {
+                *best = e;
+            }
+        };
         // Pass 1: bracket every neighbour; `bound` is the earliest time some candidate is
         // certain to reach (an exact event time, or the upper end of a bracket).
-        let skip = except.unwrap_or(i);
         let mut bound = best.time;
         let mut hits = [(0u32, 0.0f64); HITS];
         let mut n_hits = 0;
-        let particles = &self.particles;
-        let (sim_box, short) = (&self.sim_box, &self.short);
-        let mut visit = |j: usize| {
-            let q = &particles[j];
+        for j in self.cells.neighbours(i) {
+            if j == i || j == skip {
+                continue;
+            }
+            let q = &self.particles[j];
             let (a, b) = if i < j { (p, q) } else { (q, p) };
-            let exact = match bracket_pair(a, b, sim_box, now, short, bound) {
-                PairBracket::Beyond | PairBracket::Known(None) => return,
+            let exact = match bracket_pair(a, b, &self.sim_box, now, &self.short, bound) {
+                PairBracket::Beyond | PairBracket::Known(None) => continue,
                 PairBracket::Known(Some(t)) => t,
                 PairBracket::Between { lo, hi } if n_hits < HITS => {
                     hits[n_hits] = (j as u32, lo.max(now));
                     n_hits += 1;
                     bound = bound.min(hi.max(now));
-                    return;
+                    continue;
                 }
                 // No room left to defer it: evaluate it now.
-                PairBracket::Between { .. } => predict_pair(a, b, sim_box, now, short).expect("a bracketed contact"),
+                PairBracket::Between { .. } => {
+                    predict_pair(a, b, &self.sim_box, now, &self.short).expect("a bracketed contact")
+                }
             };
             let kind = PendingKind::Pair { partner: j as u32, partner_events: q.events };
-            consider(&mut best, Pending { time: exact.max(now), kind });
+            consider(best, Pending { time: exact.max(now), kind });
             bound = bound.min(best.time);
-        };
-        let mut near = [0u32; NEAR];
-        let mut n_near = 0;
-        if !self.gather {
-            // Small systems live in cache: walk the cell lists directly.
-            for &c in self.cells.around(i).as_slice() {
-                for j in self.cells.members(c) {
-                    let j = j as usize;
-                    if j != i && j != skip {
-                        visit(j);
-                    }
-                }
-            }
-        } else if self.cells.neighbours(i).filter(|&j| j != i && j != skip).all(|j| {
-            // Large systems: gather the neighbours first and touch their records together
-            // (independent loads, issued at once) so that the search finds them in cache,
-            // rather than one cell-list hop and one miss at a time between kernel calls.
-            let room = n_near < NEAR;
-            if room {
-                near[n_near] = j as u32;
-                n_near += 1;
-            }
-            room
-        }) {
-            let t_max = near[..n_near].iter().fold(f64::NEG_INFINITY, |m, &j| m.max(particles[j as usize].time));
-            std::hint::black_box(t_max);
-            for &j in &near[..n_near] {
-                visit(j as usize);
-            }
-        } else {
-            // More than NEAR neighbours (only tiny disks among large ones): walk them all.
-            for j in self.cells.neighbours(i) {
-                if j != i && j != skip {
-                    visit(j);
-                }
-            }
         }
-        // Pass 2: the exact time only where a bracket reaches down to the bound — usually
-        // one pair. A lower end equal to the bound may still tie and win, so it is kept.
+        // Pass 2, as in the batch.
         for &(j, lo) in &hits[..n_hits] {
             if lo > bound {
                 continue;
@@ -548,9 +566,8 @@ impl<const D: usize> Simulation<D> {
             let (a, b) = if i < j { (p, q) } else { (q, p) };
             let t = predict_pair(a, b, &self.sim_box, now, &self.short).expect("a bracketed contact");
             let kind = PendingKind::Pair { partner: j as u32, partner_events: q.events };
-            consider(&mut best, Pending { time: t.max(now), kind });
+            consider(best, Pending { time: t.max(now), kind });
         }
-        self.queue.set(i, best);
     }
 
     /// Processes the next event and reports it; `None` when nothing can happen any more.
@@ -690,27 +707,30 @@ mod tests {
             .expect("a valid system")
     }
 
-    /// Gathering neighbours (large systems), spilling past NEAR of them, and walking the
-    /// cell lists directly must give the same events bit for bit: only the order in which
-    /// neighbours are searched differs, and the result is the minimum in a total order.
+    /// The batch search (neighbours bracketed LANES at a time, branch-free) and the scalar
+    /// search (one pair at a time, with a shrinking horizon) must give the same events bit
+    /// for bit — including with the big disk, where predictions see more than NEAR
+    /// neighbours and the batch hands over to the scalar search: only the order in which
+    /// the pairs are searched differs, and the result is the minimum in a total order.
     #[test]
-    fn gathered_and_direct_searches_give_identical_events() {
+    fn batch_and_scalar_searches_give_identical_events() {
         for big in [false, true] {
-            let direct = system(40, big);
-            let mut gathered = direct.clone();
-            gathered.gather = true;
-            // Re-predict everything with gathering, as if it had been on from the start.
-            for i in 0..gathered.particles.len() {
-                gathered.predict(i, None);
+            let batch = system(40, big);
+            assert!(batch.batch);
+            let mut scalar = batch.clone();
+            scalar.batch = false;
+            // Re-predict everything one pair at a time, as if that had been on from the start.
+            for i in 0..scalar.particles.len() {
+                scalar.predict(i, None);
             }
-            let (mut direct, mut gathered) = (direct, gathered);
+            let (mut batch, mut scalar) = (batch, scalar);
             for _ in 0..20_000 {
-                let (a, b) = (direct.step(), gathered.step());
+                let (a, b) = (batch.step(), scalar.step());
                 assert_eq!(a, b);
-                assert_eq!(direct.time().to_bits(), gathered.time().to_bits());
+                assert_eq!(batch.time().to_bits(), scalar.time().to_bits());
             }
-            assert_eq!(direct.particles(), gathered.particles());
-            assert!(direct.counts().pair > 10_000, "{:?}", direct.counts());
+            assert_eq!(batch.particles(), scalar.particles());
+            assert!(batch.counts().pair > 10_000, "{:?}", batch.counts());
         }
     }
 }

@@ -292,6 +292,160 @@ pub fn contact_bracket<const D: usize>(first: &Ball<D>, second: &Ball<D>, horizo
     }
 }
 
+/// `L` balls in structure-of-arrays form (lane `k` is one ball), for [`contact_brackets`].
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct BallLanes<const D: usize, const L: usize> {
+    /// `position[axis][lane]`.
+    pub position: [[f64; L]; D],
+    /// `velocity[axis][lane]`.
+    pub velocity: [[f64; L]; D],
+    /// `radius[lane]`.
+    pub radius: [f64; L],
+}
+
+impl<const D: usize, const L: usize> Default for BallLanes<D, L> {
+    fn default() -> Self {
+        BallLanes { position: [[0.0; L]; D], velocity: [[0.0; L]; D], radius: [0.0; L] }
+    }
+}
+
+impl<const D: usize, const L: usize> BallLanes<D, L> {
+    /// Puts `ball` into lane `k`.
+    #[inline]
+    pub fn set(&mut self, k: usize, ball: &Ball<D>) {
+        for axis in 0..D {
+            self.position[axis][k] = ball.position[axis];
+            self.velocity[axis][k] = ball.velocity[axis];
+        }
+        self.radius[k] = ball.radius;
+    }
+
+    /// The ball in lane `k`.
+    pub fn get(&self, k: usize) -> Ball<D> {
+        Ball {
+            position: core::array::from_fn(|axis| self.position[axis][k]),
+            velocity: core::array::from_fn(|axis| self.velocity[axis][k]),
+            radius: self.radius[k],
+        }
+    }
+}
+
+/// [`contact_bracket`] for `L` pairs at once, without branches: lane `k` of `first` against
+/// lane `k` of `second`. On return `lo[k] ≤ T ≤ hi[k]`, where `T` is the time of
+/// [`contact_time_unchecked`]`(first_k, second_k)` — `0` for [`Contact::Now`], `t` for
+/// `At(t)`, `+∞` for `Never`:
+///
+/// | the filter certifies | `[lo, hi]` |
+/// |---|---|
+/// | receding (`b > 0`) or missing paths (`D < 0`) | `[+∞, +∞]` |
+/// | approaching while overlapping (`b < 0`, `c < 0`) | `[0, 0]` |
+/// | a contact (`b < 0`, `c > 0`, `D > 0`) | exactly [`contact_bracket`]'s `Between { lo, hi }` |
+/// | nothing (a sign too close to call, or inputs outside `2^±150`, NaN, ∞) | `[0, +∞]` |
+///
+/// Every lane computes every step and the verdicts are merged by selects, so the compiler
+/// can keep all `L` lanes in vector registers (the engine uses `L = 8`, one AVX-512
+/// register or two AVX2 ones): on a particle's neighbours the verdict is data-dependent
+/// and close to a coin toss (about half the neighbours recede), which a branch per pair
+/// mispredicts. The caller evaluates [`contact_time_unchecked`] only where `lo` does not
+/// exceed the smallest `hi`. Unused lanes may hold anything; their output is meaningless.
+///
+/// ```
+/// use quadratic::{contact_brackets, Ball, BallLanes};
+/// let mut first = BallLanes::<2, 4>::default();
+/// let mut second = BallLanes::<2, 4>::default();
+/// first.set(0, &Ball { position: [0.0, 0.0], velocity: [1.0, 0.0], radius: 0.5 });
+/// second.set(0, &Ball { position: [5.0, 0.0], velocity: [-1.0, 0.0], radius: 0.5 }); // t = 2
+/// first.set(1, &Ball { position: [0.0, 0.0], velocity: [-1.0, 0.0], radius: 0.5 });
+/// second.set(1, &Ball { position: [5.0, 0.0], velocity: [1.0, 0.0], radius: 0.5 }); // receding
+/// let (mut lo, mut hi) = ([0.0; 4], [0.0; 4]);
+/// contact_brackets(&first, &second, &mut lo, &mut hi);
+/// assert!(lo[0] <= 2.0 && 2.0 <= hi[0] && hi[0] - lo[0] < 1e-13);
+/// assert_eq!((lo[1], hi[1]), (f64::INFINITY, f64::INFINITY));
+/// ```
+#[inline]
+pub fn contact_brackets<const D: usize, const L: usize>(
+    first: &BallLanes<D, L>,
+    second: &BallLanes<D, L>,
+    lo: &mut [f64; L],
+    hi: &mut [f64; L],
+) {
+    const HI: f64 = pow2(150);
+    const LO: f64 = pow2(-150);
+    const INF: f64 = f64::INFINITY;
+    // The same expressions as `filtered` (see the bounds there), lane by lane; the brackets
+    // of certified contacts are bit-identical to `contact_bracket`'s.
+    for k in 0..L {
+        let (r1, r2) = (first.radius[k], second.radius[k]);
+        let s = r1 + r2;
+        let mut ok = r1 >= 0.0 && r2 >= 0.0 && s <= HI;
+        let (mut lmax, mut vmax) = (s, 0.0f64);
+        let mut h = [0.0; D];
+        let mut g = [0.0; D];
+        for i in 0..D {
+            h[i] = second.position[i][k] - first.position[i][k];
+            g[i] = second.velocity[i][k] - first.velocity[i][k];
+            let (ah, ag) = (h[i].abs(), g[i].abs());
+            ok &= ah <= HI && ag <= HI;
+            lmax = lmax.max(ah);
+            vmax = vmax.max(ag);
+        }
+        ok &= lmax >= LO && vmax >= LO;
+        let (mut b, mut p) = (0.0, 0.0);
+        for i in 0..D {
+            b = h[i].mul_add(g[i], b);
+            p += (h[i] * g[i]).abs();
+        }
+        let bound_b = (D as f64 + 4.0) * U * p + SLACK;
+        let (mut c, mut q) = (-(s * s), s * s);
+        for &x in &h {
+            c = x.mul_add(x, c);
+            q = x.mul_add(x, q);
+        }
+        let bound_c = (D as f64 + 5.0) * U * q + SLACK;
+        let mut a = 0.0;
+        for &x in &g {
+            a = x.mul_add(x, a);
+        }
+        let asig = a * (s * s);
+        let (mut disc, mut scale) = (asig, asig);
+        for i in 0..D {
+            for j in i + 1..D {
+                let (hi, hj, gi, gj) = (h[i], h[j], g[i], g[j]);
+                let cross = hi.mul_add(gj, -(hj * gi));
+                let x = (hi * gj).abs() + (hj * gi).abs();
+                disc = (-cross).mul_add(cross, disc);
+                scale = x.mul_add(x, scale);
+            }
+        }
+        let bound_d = 32.0 * U * scale + SLACK;
+        let low = (c - bound_c) / ((bound_b - b) + (disc + bound_d).sqrt());
+        let high = (c + bound_c) / ((-b - bound_b) + (disc - bound_d).sqrt());
+        let low = (low * (1.0 - 16.0 * U) - f64::MIN_POSITIVE).max(0.0);
+        let high = high * (1.0 + 16.0 * U) + f64::MIN_POSITIVE;
+        // The verdicts in the filter's order; the first that applies wins.
+        let approaching = b < -bound_b;
+        let (l, h) = if !ok {
+            (0.0, INF)
+        } else if b > bound_b {
+            (INF, INF)
+        } else if !approaching {
+            (0.0, INF)
+        } else if c < -bound_c {
+            (0.0, 0.0)
+        } else if c <= bound_c {
+            (0.0, INF)
+        } else if disc < -bound_d {
+            (INF, INF)
+        } else if disc <= bound_d {
+            (0.0, INF)
+        } else {
+            (low, high)
+        };
+        lo[k] = l;
+        hi[k] = h;
+    }
+}
+
 /// What the filter concluded.
 enum Verdict {
     /// The certified answer.

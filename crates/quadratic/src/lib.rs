@@ -12,7 +12,8 @@
 //! * [`contact_bracket`] and [`contact_time_within`] serve a search for the earliest of many
 //!   contacts: a certified interval for the time (or "later than the horizon") from the f64
 //!   filter alone, so that only the one or two candidates that can come first pay for the
-//!   double-double root.
+//!   double-double root. [`contact_brackets`] does the same for a batch of pairs held in
+//!   [`BallLanes`] (structure of arrays), branch-free, so that the pairs share vector registers.
 //! * [`exact`] holds the error-free building blocks (TwoSum, FMA TwoProd, Shewchuk
 //!   expansions, double-double); [`hex`] reads and writes C99 hex floats; [`textbook`]
 //!   is the seed's naive formula, kept only for comparison.
@@ -50,7 +51,7 @@ pub mod textbook;
 #[doc(hidden)]
 pub use contact::contact_time_exact_path;
 pub use contact::{
-    Ball, Bracket, Contact, ContactError, Field, Miss, contact_bracket, contact_time, contact_time_unchecked,
-    contact_time_within,
+    Ball, BallLanes, Bracket, Contact, ContactError, Field, Miss, contact_bracket, contact_brackets, contact_time,
+    contact_time_unchecked, contact_time_within,
 };
 pub use roots::{Coefficient, Roots, SolveError, solve};

@@ -15,7 +15,7 @@ use common::runner;
 use proptest::prelude::*;
 use proptest::strategy::BoxedStrategy;
 use proptest::test_runner::TestCaseError;
-use quadratic::{Ball, Bracket, Contact, textbook};
+use quadratic::{Ball, BallLanes, Bracket, Contact, textbook};
 use std::cell::RefCell;
 
 /// Cases per family. The contract is a worst-case claim, so more is better; 20 000 per
@@ -156,7 +156,8 @@ fn contact_time_contract_on_every_family_3d() {
 /// `contact_time_within` and `contact_bracket` may drop a pair only when its exact contact
 /// time is later than the horizon; otherwise `contact_time_within` gives exactly
 /// `contact_time`'s answer, and `contact_bracket` either that answer or an interval that holds
-/// the time `contact_time` returns. Horizons sit at, one
+/// the time `contact_time` returns; `contact_brackets` (the batch kernel) brackets every lane's
+/// answer and matches `contact_bracket`'s certified intervals bit for bit. Horizons sit at, one
 /// ulp either side of, and well before and after each contact time (and at 0, −1, ±∞).
 fn within_contract<const D: usize>(families: Vec<(&'static str, BoxedStrategy<(Ball<D>, Ball<D>)>)>) {
     use common::families::nudge;
@@ -201,6 +202,37 @@ fn within_contract<const D: usize>(families: Vec<(&'static str, BoxedStrategy<(B
                             if hi - lo <= 1e-12 * hi {
                                 *tight.borrow_mut() += 1;
                             }
+                        }
+                    }
+                }
+                if k == 7 {
+                    // The batch kernel on the same pair (lane 0), the pair swapped (lane 1)
+                    // and copies: every lane brackets its own answer, and a certified contact
+                    // gets exactly `contact_bracket`'s interval.
+                    let (mut first, mut second) = (BallLanes::<D, 8>::default(), BallLanes::<D, 8>::default());
+                    for lane in 0..8 {
+                        let (x, y) = if lane % 2 == 0 { (&p, &q) } else { (&q, &p) };
+                        first.set(lane, x);
+                        second.set(lane, y);
+                    }
+                    let (mut lo, mut hi) = ([0.0; 8], [0.0; 8]);
+                    quadratic::contact_brackets(&first, &second, &mut lo, &mut hi);
+                    for lane in 0..8 {
+                        let (x, y) = if lane % 2 == 0 { (&p, &q) } else { (&q, &p) };
+                        let want = quadratic::contact_time(x, y).expect("valid inputs");
+                        let t = want.time().unwrap_or(f64::INFINITY);
+                        prop_assert!(
+                            lo[lane] <= t && t <= hi[lane],
+                            "{:?} {:?}: lane {} has [{:e}, {:e}] for {:?}",
+                            x,
+                            y,
+                            lane,
+                            lo[lane],
+                            hi[lane],
+                            want
+                        );
+                        if let Bracket::Between { lo: l, hi: h } = quadratic::contact_bracket(x, y, h) {
+                            prop_assert_eq!((lo[lane].to_bits(), hi[lane].to_bits()), (l.to_bits(), h.to_bits()));
                         }
                     }
                 }
