@@ -166,7 +166,7 @@ impl fmt::Display for SetupError {
                 write!(f, "particle {index} is outside the walls along axis {axis} (coordinate {coordinate})")
             }
             SetupError::TooMany { n } => {
-                write!(f, "{n} particles: the engine handles at most {}", u32::MAX - 1)
+                write!(f, "{n} particles: the engine handles at most {}", MAX_PARTICLES)
             }
             SetupError::BadState { what } => write!(f, "inconsistent saved state: {what}"),
             SetupError::Overlap { i, j, fraction } => {
@@ -191,6 +191,10 @@ pub struct OverlapAudit {
 /// Brackets kept per prediction before falling back to exact evaluation on the spot (a
 /// particle rarely has more than a handful of approaching neighbours).
 const HITS: usize = 32;
+
+/// The most particles a simulation takes: indices are 32-bit, and the event queue pads the
+/// particles with up to two empty slots.
+pub const MAX_PARTICLES: usize = u32::MAX as usize - 4;
 
 /// Neighbours gathered per prediction for the batch search (more: the scalar search).
 const NEAR: usize = 64;
@@ -635,7 +639,7 @@ fn validate<const D: usize>(particles: &[Particle<D>], sim_box: &SimBox<D>) -> R
     if particles.is_empty() {
         return Err(SetupError::Empty);
     }
-    if particles.len() >= u32::MAX as usize {
+    if particles.len() > MAX_PARTICLES {
         return Err(SetupError::TooMany { n: particles.len() });
     }
     let mut rmax: f64 = 0.0;
