@@ -3,12 +3,16 @@
 //! events until one more pair collision has happened, so criterion's throughput is in
 //! collisions per second.
 //!
-//! `engine/parts` times two pieces of one collision's work at N = 10⁴, η = 0.65, to show where
+//! `engine/parts` times pieces of one collision's work at N = 10⁴, η = 0.65, to show where
 //! the time goes: `bracket_pair` over every pair of a warmed-up state closer than 1.8σ (per
-//! pair), and replacing the event of the particle at the root of the queue's tree (per
-//! update; the root owner's is the longest walk, as after every collision).
+//! pair); `bracket_neighbours`, the batch version the engine runs, over every particle's
+//! cell neighbours (per particle, i.e. per prediction); and replacing the event of the
+//! particle at the root of the queue's tree (per update; the root owner's is the longest
+//! walk, as after every collision).
 
-use collide::engine::events::{PairBracket, Pending, PendingKind, bracket_pair, pair_positions};
+use collide::engine::events::{
+    LANES, PairBracket, Pending, PendingKind, bracket_neighbours, bracket_pair, pair_positions,
+};
 use collide::engine::init::{Placement, Species, Velocities, box_for_packing_fraction, initial_particles};
 use collide::engine::queue::EventQueue;
 use collide::engine::{Boundary, Simulation};
@@ -73,6 +77,26 @@ fn parts(c: &mut Criterion) {
                     bracket_pair(&ps[i], &ps[j], sim_box, black_box(now), &[false; 2], f64::INFINITY)
                 {
                     n += lo;
+                }
+            }
+            n
+        })
+    });
+    // Each particle's neighbours within 1.8σ (the pairs above), in chunks of LANES.
+    let mut near: Vec<Vec<u32>> = vec![Vec::new(); ps.len()];
+    for &(i, j) in &pairs {
+        near[i].push(j as u32);
+        near[j].push(i as u32);
+    }
+    group.throughput(Throughput::Elements(ps.len() as u64));
+    group.bench_function("bracket_neighbours", |b| {
+        b.iter(|| {
+            let mut n = 0.0;
+            for (i, js) in near.iter().enumerate() {
+                for chunk in js.chunks(LANES) {
+                    let (mut lo, mut hi) = ([0.0; LANES], [0.0; LANES]);
+                    bracket_neighbours(ps, i, chunk, sim_box, black_box(now), &mut lo, &mut hi);
+                    n += hi[0];
                 }
             }
             n

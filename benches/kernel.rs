@@ -10,11 +10,15 @@
 //! `robust` is `quadratic::contact_time` / `quadratic::solve`, `textbook` the seed's formula,
 //! `exact-path` the expansion fallback alone (what every pair would cost without the filter),
 //! `bracket` the certified interval `quadratic::contact_bracket` that the engine computes for
-//! every neighbour before it evaluates exactly the one or two pairs that can come first.
+//! every neighbour before it evaluates exactly the one or two pairs that can come first,
+//! `brackets-8` the same intervals from the branch-free batch kernel
+//! `quadratic::contact_brackets`, eight pairs per call (what the engine runs).
 //! Reported per batch; divide by the batch size (printed as throughput) for the cost per call.
 
 use criterion::{Criterion, Throughput, criterion_group, criterion_main};
-use quadratic::{Ball, Bracket, contact_bracket, contact_time, contact_time_exact_path, solve, textbook};
+use quadratic::{
+    Ball, BallLanes, Bracket, contact_bracket, contact_brackets, contact_time, contact_time_exact_path, solve, textbook,
+};
 use rand::rngs::Xoshiro256PlusPlus;
 use rand::{RngExt, SeedableRng};
 use rand_distr::{Distribution, StandardNormal};
@@ -109,6 +113,30 @@ fn contact(c: &mut Criterion) {
                         Bracket::Known(c) => c.time().unwrap_or(-1.0),
                         Bracket::Beyond => -2.0,
                     };
+                }
+                n
+            })
+        });
+        // The pairs in lanes of eight (the last lanes padded with copies of the first pair).
+        let lanes: Vec<(BallLanes<2, 8>, BallLanes<2, 8>)> = pairs
+            .chunks(8)
+            .map(|chunk| {
+                let (mut first, mut second) = (BallLanes::default(), BallLanes::default());
+                for k in 0..8 {
+                    let (p, q) = chunk.get(k).unwrap_or(&chunk[0]);
+                    first.set(k, p);
+                    second.set(k, q);
+                }
+                (first, second)
+            })
+            .collect();
+        group.bench_function("brackets-8", |b| {
+            b.iter(|| {
+                let mut n = 0.0;
+                for (first, second) in &lanes {
+                    let (mut lo, mut hi) = ([0.0; 8], [0.0; 8]);
+                    contact_brackets(black_box(first), black_box(second), &mut lo, &mut hi);
+                    n += lo.iter().sum::<f64>();
                 }
                 n
             })

@@ -3,7 +3,7 @@
 //!
 //! Each particle has exactly one pending event — the earliest of its collisions with the
 //! particles in the cells around it, its next wall and its next cell crossing — held in a
-//! tournament tree ([`EventQueue`]). `step()` takes the earliest; a pair event whose partner
+//! 4-ary tournament tree ([`EventQueue`]). `step()` takes the earliest; a pair event whose partner
 //! has changed velocity since it was predicted (per-particle event counters) is a
 //! re-prediction marker: its owner is predicted again and nothing happens. Otherwise the
 //! particles involved are advanced to the event time, the event is resolved, they are
@@ -452,11 +452,16 @@ impl<const D: usize> Simulation<D> {
     /// `except` skips one partner (just resolved with `i`; the partner's own prediction
     /// covers the pair).
     ///
-    /// Walls and the cell crossing come first so that the pairs are searched against a
-    /// finite horizon. Pairs are then bracketed ([`bracket_pair`]: the kernel's f64 filter
-    /// with error bounds, no double-double root), and only those whose bracket reaches down
-    /// to the earliest certain time are evaluated exactly. The result is the same event as
-    /// evaluating every pair exactly: nothing is dropped that could come first or tie.
+    /// Walls and the cell crossing come first: their times bound the search. The neighbours
+    /// are gathered from the cell lists and bracketed [`LANES`] at a time by the branch-free
+    /// batch kernel ([`bracket_neighbours`]: the f64 filter with certified error bounds, no
+    /// double-double root); the bound becomes the smallest upper end. Only the pairs whose
+    /// lower end reaches down to it are candidates, and a candidate whose bracket ends round
+    /// to the same absolute time has that time exactly; the rest get the exact root. The
+    /// result is the same event as evaluating every pair exactly: nothing is dropped that
+    /// could come first or tie (checked against the one-pair-at-a-time search and the
+    /// brute-force reference). Short periodic axes and crowds of more than [`NEAR`]
+    /// neighbours take the scalar search.
     fn predict(&mut self, i: usize, except: Option<usize>) {
         let p = &self.particles[i];
         let now = self.time;
