@@ -390,38 +390,10 @@ pub fn contact_brackets<const D: usize, const L: usize>(
             vmax = vmax.max(ag);
         }
         ok &= lmax >= LO && vmax >= LO;
-        let (mut b, mut p) = (0.0, 0.0);
-        for i in 0..D {
-            b = h[i].mul_add(g[i], b);
-            p += (h[i] * g[i]).abs();
-        }
-        let bound_b = (D as f64 + 4.0) * U * p + SLACK;
-        let (mut c, mut q) = (-(s * s), s * s);
-        for &x in &h {
-            c = x.mul_add(x, c);
-            q = x.mul_add(x, q);
-        }
-        let bound_c = (D as f64 + 5.0) * U * q + SLACK;
-        let mut a = 0.0;
-        for &x in &g {
-            a = x.mul_add(x, a);
-        }
-        let asig = a * (s * s);
-        let (mut disc, mut scale) = (asig, asig);
-        for i in 0..D {
-            for j in i + 1..D {
-                let (hi, hj, gi, gj) = (h[i], h[j], g[i], g[j]);
-                let cross = hi.mul_add(gj, -(hj * gi));
-                let x = (hi * gj).abs() + (hj * gi).abs();
-                disc = (-cross).mul_add(cross, disc);
-                scale = x.mul_add(x, scale);
-            }
-        }
-        let bound_d = 32.0 * U * scale + SLACK;
-        let low = (c - bound_c) / ((bound_b - b) + (disc + bound_d).sqrt());
-        let high = (c + bound_c) / ((-b - bound_b) + (disc - bound_d).sqrt());
-        let low = (low * (1.0 - 16.0 * U) - f64::MIN_POSITIVE).max(0.0);
-        let high = high * (1.0 + 16.0 * U) + f64::MIN_POSITIVE;
+        let (b, _, bound_b) = filter_b(&h, &g);
+        let (c, _, bound_c) = filter_c(&h, s);
+        let (disc, _, bound_d) = filter_disc(&h, &g, s);
+        let (low, high) = bracket_ends((b, bound_b), (c, bound_c), (disc, bound_d));
         // The verdicts in the filter's order; the first that applies wins.
         let approaching = b < -bound_b;
         let (l, h) = if !ok {
@@ -590,13 +562,7 @@ fn filtered<const D: usize, const BRACKET: bool>(first: &Ball<D>, second: &Ball<
     }
     // --- b = ⟨Δv|Δr⟩ in f64. With P = Σ|hᵢgᵢ|: the FMA chain errs by ≤ D·u·P(1+Du) and
     // the dropped terms hᵢmᵢ + lᵢgᵢ + lᵢmᵢ by ≤ (2u + u²)P; (D + 4)·u·P covers both.
-    let mut b = 0.0;
-    let mut p = 0.0;
-    for i in 0..D {
-        b = h[i].mul_add(g[i], b);
-        p += (h[i] * g[i]).abs();
-    }
-    let bound_b = (D as f64 + 4.0) * U * p + SLACK;
+    let (b, p, bound_b) = filter_b(&h, &g);
     if b > bound_b {
         return Verdict::Decided(Contact::Never(Miss::Receding));
     }
@@ -605,13 +571,7 @@ fn filtered<const D: usize, const BRACKET: bool>(first: &Ball<D>, second: &Ball<
     }
     // --- c = |Δr|² − σ². With Q = Σhᵢ² + s²: chain error ≤ (D + 1)·u·Q, dropped
     // 2hᵢlᵢ + lᵢ² − 2st − t² ≤ (2u + u²)·Q.
-    let mut c = -(s * s);
-    let mut q = s * s;
-    for &x in &h {
-        c = x.mul_add(x, c);
-        q = x.mul_add(x, q);
-    }
-    let bound_c = (D as f64 + 5.0) * U * q + SLACK;
+    let (c, q, bound_c) = filter_c(&h, s);
     if c < -bound_c {
         return Verdict::Decided(Contact::Now);
     }
@@ -628,23 +588,7 @@ fn filtered<const D: usize, const BRACKET: bool>(first: &Ball<D>, second: &Ball<
     // --- D = |Δv|²σ² − Σ_{i<j}(ΔrᵢΔvⱼ − ΔrⱼΔvᵢ)². With Xᵢⱼ = |hᵢgⱼ| + |hⱼgᵢ| and
     // A = a·s² + ΣXᵢⱼ²: each factor errs by a few u relative to its own scale (a by
     // (D + 3)u, s² by 3u, each cross term by 4u·Xᵢⱼ), so 32·u·A bounds the total for D ≤ 3.
-    let mut a = 0.0;
-    for &x in &g {
-        a = x.mul_add(x, a);
-    }
-    let asig = a * (s * s);
-    let mut disc = asig;
-    let mut scale = asig;
-    for i in 0..D {
-        for j in i + 1..D {
-            let (hi, hj, gi, gj) = (h[i], h[j], g[i], g[j]);
-            let cross = hi.mul_add(gj, -(hj * gi));
-            let x = (hi * gj).abs() + (hj * gi).abs();
-            disc = (-cross).mul_add(cross, disc);
-            scale = x.mul_add(x, scale);
-        }
-    }
-    let bound_d = 32.0 * U * scale + SLACK;
+    let (disc, scale, bound_d) = filter_disc(&h, &g, s);
     if disc < -bound_d {
         return Verdict::Decided(Contact::Never(Miss::PathsMiss));
     }
@@ -656,10 +600,7 @@ fn filtered<const D: usize, const BRACKET: bool>(first: &Ball<D>, second: &Ball<
         // smallest numerator over largest denominator and vice versa. About eight roundings
         // of at most u each (sqrt, sums, quotient), plus 1 ulp for the time actually returned:
         // 16u on each side covers them, and MIN_POSITIVE any underflow.
-        let lo = (c - bound_c) / ((bound_b - b) + (disc + bound_d).sqrt());
-        let hi = (c + bound_c) / ((-b - bound_b) + (disc - bound_d).sqrt());
-        let lo = (lo * (1.0 - 16.0 * U) - f64::MIN_POSITIVE).max(0.0);
-        let hi = hi * (1.0 + 16.0 * U) + f64::MIN_POSITIVE;
+        let (lo, hi) = bracket_ends((b, bound_b), (c, bound_c), (disc, bound_d));
         return if lo > horizon { Verdict::Beyond } else { Verdict::Between(lo, hi) };
     }
     // --- All three signs certified: b < 0, c > 0, D > 0. Now the values, in double-double.
@@ -725,6 +666,59 @@ fn filtered<const D: usize, const BRACKET: bool>(first: &Ball<D>, second: &Ball<
     let den = neg_b.add(d_dd.sqrt());
     let t = c_dd.div(den);
     Verdict::Decided(Contact::At(t.hi + t.lo))
+}
+
+/// `b̃ = ⟨g|h⟩` (FMA chain), `P = Σ|hᵢgᵢ|` and the bound `β` on `|b − b̃|` (see [`filtered`]).
+#[inline(always)]
+fn filter_b<const D: usize>(h: &[f64; D], g: &[f64; D]) -> (f64, f64, f64) {
+    let (mut b, mut p) = (0.0, 0.0);
+    for i in 0..D {
+        b = h[i].mul_add(g[i], b);
+        p += (h[i] * g[i]).abs();
+    }
+    (b, p, (D as f64 + 4.0) * U * p + SLACK)
+}
+
+/// `c̃ = |h|² − s²`, `Q = |h|² + s²` and the bound `γ` on `|c − c̃|` (see [`filtered`]).
+#[inline(always)]
+fn filter_c<const D: usize>(h: &[f64; D], s: f64) -> (f64, f64, f64) {
+    let (mut c, mut q) = (-(s * s), s * s);
+    for &x in h {
+        c = x.mul_add(x, c);
+        q = x.mul_add(x, q);
+    }
+    (c, q, (D as f64 + 5.0) * U * q + SLACK)
+}
+
+/// `D̃ = |g|²s² − Σ_{i<j}(hᵢgⱼ − hⱼgᵢ)²`, its scale `A` and the bound `δ` on `|D − D̃|` (see
+/// [`filtered`]).
+#[inline(always)]
+fn filter_disc<const D: usize>(h: &[f64; D], g: &[f64; D], s: f64) -> (f64, f64, f64) {
+    let mut a = 0.0;
+    for &x in g {
+        a = x.mul_add(x, a);
+    }
+    let asig = a * (s * s);
+    let (mut disc, mut scale) = (asig, asig);
+    for i in 0..D {
+        for j in i + 1..D {
+            let (hi, hj, gi, gj) = (h[i], h[j], g[i], g[j]);
+            let cross = hi.mul_add(gj, -(hj * gi));
+            let x = (hi * gj).abs() + (hj * gi).abs();
+            disc = (-cross).mul_add(cross, disc);
+            scale = x.mul_add(x, scale);
+        }
+    }
+    (disc, scale, 32.0 * U * scale + SLACK)
+}
+
+/// The certified bracket of `t = c/(−b + √D)` from the three values and their bounds, when
+/// `b < 0`, `c > 0`, `D > 0` are certified (see the bracket step of [`filtered`]).
+#[inline(always)]
+fn bracket_ends((b, bound_b): (f64, f64), (c, bound_c): (f64, f64), (disc, bound_d): (f64, f64)) -> (f64, f64) {
+    let lo = (c - bound_c) / ((bound_b - b) + (disc + bound_d).sqrt());
+    let hi = (c + bound_c) / ((-b - bound_b) + (disc - bound_d).sqrt());
+    ((lo * (1.0 - 16.0 * U) - f64::MIN_POSITIVE).max(0.0), hi * (1.0 + 16.0 * U) + f64::MIN_POSITIVE)
 }
 
 /// A double-double accumulator: heads summed exactly by TwoSum, tails in plain f64.
