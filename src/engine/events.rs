@@ -235,7 +235,9 @@ pub const LANES: usize = 8;
 /// [`bracket_pair`] for particle `i` against up to [`LANES`] neighbours `js` at once, when no
 /// axis is short, through the branch-free batch kernel [`contact_brackets`]. On return, for
 /// each `k < js.len()`: if [`predict_pair`] gives `Some(t)` for the pair, then
-/// `lo[k] ≤ max(t, now) ≤ hi[k]` (absolute times); `lo[k] = +∞` only when it gives `None`.
+/// `lo[k] ≤ max(t, now) ≤ hi[k]` (absolute times); `lo[k] = +∞` when it gives `None` (or a
+/// time that itself overflows to `+∞`, so a caller searching up to an infinite bound still
+/// asks [`predict_pair`]).
 /// The balls are exactly those [`bracket_pair`] would form, so the certified intervals are
 /// the same to the bit.
 #[inline]
