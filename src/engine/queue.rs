@@ -123,7 +123,11 @@ impl EventQueue {
     #[inline(always)]
     fn earlier(&self, a: Node, b: Node) -> Node {
         let b_first = if a.time == b.time { self.tie_b_first(a, b) } else { b.time < a.time };
-        if b_first { b } else { a }
+        // The winner's time is the smaller one (equal times are equal as f64, whichever wins
+        // the tie), so no branch picks it: written as an `if`, the compiler branched on it
+        // (it has no conditional move for an f64), and those branches were a third of the
+        // engine's mispredictions (callgrind's branch simulation at N = 10⁴, η = 0.65).
+        Node { time: a.time.min(b.time), owner: std::hint::select_unpredictable(b_first, b.owner, a.owner) }
     }
 
     #[cold]
