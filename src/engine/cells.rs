@@ -80,6 +80,8 @@ impl<const D: usize> Cells<D> {
             cells.next.push(NONE);
             cells.insert(i);
         }
+        // The sentinel link past the last particle (see `gather`).
+        cells.next.push(NONE);
         cells.coords.shrink_to_fit();
         cells.next.shrink_to_fit();
         cells
@@ -88,7 +90,7 @@ impl<const D: usize> Cells<D> {
     /// Rebuilds a grid from stored unwrapped coordinates (checkpoints).
     pub fn from_coords(sim_box: &SimBox<D>, reach: f64, coords: Vec<[i64; D]>) -> Self {
         let mut cells = Cells::new(sim_box, reach, std::iter::empty());
-        cells.next = vec![NONE; coords.len()];
+        cells.next = vec![NONE; coords.len() + 1];
         cells.coords = coords;
         for i in 0..cells.coords.len() {
             cells.insert(i);
@@ -175,16 +177,22 @@ impl<const D: usize> Cells<D> {
     }
 
     /// The distinct cells adjacent to (and including) particle `i`'s cell, each listed once
-    /// even when an axis has fewer than three cells; no allocation.
+    /// even when an axis has fewer than three cells; no allocation. The order is the flat
+    /// index order of a 3^D block: axis 0 fastest.
     pub fn around(&self, i: usize) -> Around {
         let m = self.coords[i];
-        // Per axis, the distinct wrapped coordinates among m − 1, m, m + 1 (inside the walls).
-        let mut axis_coords = [[0usize; 3]; D];
-        let mut axis_len = [0usize; D];
+        // Per axis, the distinct wrapped coordinates among m − 1, m, m + 1 (inside the walls),
+        // already multiplied by the axis' stride in the flat index. Axes past D get the one
+        // offset 0, so one triple loop serves every D ≤ 3 (this replaced a general odometer
+        // that cost about 340 instructions a call; callgrind, N = 10⁴, η = 0.65).
+        let mut offsets = [[0usize; 3]; 3];
+        let mut lens = [1usize; 3];
+        let mut stride = 1;
         for a in 0..D {
             let n = self.counts[a] as i64;
             // One division per axis; the neighbours wrap by comparison.
             let centre = m[a].rem_euclid(n);
+            let mut len = 0;
             for o in -1..=1 {
                 if self.boundary[a] == Boundary::Wall && !(0..n).contains(&(m[a] + o)) {
                     continue;
@@ -196,32 +204,27 @@ impl<const D: usize> Cells<D> {
                     x - n
                 } else {
                     x
-                } as usize;
-                if !axis_coords[a][..axis_len[a]].contains(&w) {
-                    axis_coords[a][axis_len[a]] = w;
-                    axis_len[a] += 1;
+                } as usize
+                    * stride;
+                // With three cells or more the three are distinct; fewer wrap onto each other.
+                if n >= 3 || !offsets[a][..len].contains(&w) {
+                    offsets[a][len] = w;
+                    len += 1;
+                }
+            }
+            lens[a] = len;
+            stride *= self.counts[a];
+        }
+        let mut around = Around { cells: [0; 27], len: 0 };
+        for &z in &offsets[2][..lens[2]] {
+            for &y in &offsets[1][..lens[1]] {
+                for &x in &offsets[0][..lens[0]] {
+                    around.cells[around.len] = (x + y + z) as u32;
+                    around.len += 1;
                 }
             }
         }
-        let mut around = Around { cells: [0; 27], len: 0 };
-        let mut pick = [0usize; D];
-        loop {
-            let mut index = 0;
-            for a in (0..D).rev() {
-                index = index * self.counts[a] + axis_coords[a][pick[a]];
-            }
-            around.cells[around.len] = index as u32;
-            around.len += 1;
-            let mut a = 0;
-            while a < D && pick[a] + 1 == axis_len[a] {
-                pick[a] = 0;
-                a += 1;
-            }
-            if a == D {
-                return around;
-            }
-            pick[a] += 1;
-        }
+        around
     }
 
     /// The particles in cell `c` (a flat index from [`Cells::around`]).
@@ -231,13 +234,27 @@ impl<const D: usize> Cells<D> {
     }
 
     /// Writes the particles in the cells around particle `i`, except `i` and `skip`, into
-    /// `out` and returns how many — or `None` as soon as they do not fit.
+    /// `out` and returns how many — or `None` when they may not fit (`out` full before the
+    /// last member is looked at).
+    ///
+    /// The first two members of each cell are taken without branches: a cell one contact
+    /// distance wide seldom holds more, and how many it holds is a coin toss for the branch
+    /// predictor (a loop per cell cost about 2 mispredictions per gather; callgrind's branch
+    /// simulation, N = 10⁴, η = 0.65). The end of a list, `NONE`, reads the sentinel link
+    /// past the last particle, which is `NONE` again, and is not counted.
     #[inline]
     pub fn gather(&self, i: usize, skip: usize, out: &mut [u32]) -> Option<usize> {
         let around = self.around(i);
+        let sentinel = self.next.len() - 1;
         let mut len = 0;
         for &c in around.as_slice() {
             let mut j = self.head[c as usize];
+            for _ in 0..2 {
+                let k = (j as usize).min(sentinel);
+                *out.get_mut(len)? = j;
+                len += ((j != NONE) & (k != i) & (k != skip)) as usize;
+                j = self.next[k];
+            }
             while j != NONE {
                 if j as usize != i && j as usize != skip {
                     *out.get_mut(len)? = j;
