@@ -95,7 +95,9 @@ fn parts(c: &mut Criterion) {
             for (i, js) in near.iter().enumerate() {
                 for chunk in js.chunks(LANES) {
                     let (mut lo, mut hi) = ([0.0; LANES], [0.0; LANES]);
-                    bracket_neighbours(ps, i, chunk, sim_box, black_box(now), &mut lo, &mut hi);
+                    let mut js = [i as u32; LANES];
+                    js[..chunk.len()].copy_from_slice(chunk);
+                    bracket_neighbours(ps, i, &js, chunk.len(), sim_box, black_box(now), &mut lo, &mut hi);
                     n += hi[0];
                 }
             }

@@ -157,23 +157,30 @@ impl<const D: usize> Cells<D> {
 
     /// The time from `t0` at which a particle at `x` (at `t0`) moving with `v` leaves cell
     /// `m` — `(Δt, axis, up)` — or `None` if it never does (at rest, or only walls ahead).
+    ///
+    /// Which axis is crossed first, and in which direction, is a coin toss for the branch
+    /// predictor, so both are chosen by selects, not branches.
     pub fn next_crossing(&self, m: &[i64; D], x: &SVector<f64, D>, v: &SVector<f64, D>) -> Option<(f64, usize, bool)> {
-        let mut best: Option<(f64, usize, bool)> = None;
+        let (mut best_dt, mut best_axis, mut best_up) = (f64::INFINITY, usize::MAX, false);
         for a in 0..D {
-            let up = v[a] > 0.0;
             if v[a] == 0.0 {
                 continue;
             }
-            if self.boundary[a] == Boundary::Wall && ((up && m[a] + 1 >= self.counts[a] as i64) || (!up && m[a] <= 0)) {
+            let up = v[a] > 0.0;
+            if self.boundary[a] == Boundary::Wall
+                && std::hint::select_unpredictable(up, m[a] + 1 >= self.counts[a] as i64, m[a] <= 0)
+            {
                 continue;
             }
-            let edge = if up { m[a] + 1 } else { m[a] } as f64 * self.widths[a];
+            let edge = (m[a] + up as i64) as f64 * self.widths[a];
             let dt = ((edge - x[a]) / v[a]).max(0.0);
-            if best.is_none_or(|(b, _, _)| dt < b) {
-                best = Some((dt, a, up));
-            }
+            // The first axis, or an earlier crossing than the best so far (ties: lower axis).
+            let better = dt < best_dt || best_axis == usize::MAX;
+            best_dt = best_dt.min(dt);
+            best_axis = std::hint::select_unpredictable(better, a, best_axis);
+            best_up = std::hint::select_unpredictable(better, up, best_up);
         }
-        best
+        (best_axis != usize::MAX).then_some((best_dt, best_axis, best_up))
     }
 
     /// The distinct cells adjacent to (and including) particle `i`'s cell, each listed once

@@ -232,19 +232,22 @@ pub fn bracket_pair<const D: usize>(
 /// Pairs bracketed at once by [`bracket_neighbours`]: one AVX-512 register of f64 (two AVX2).
 pub const LANES: usize = 8;
 
-/// [`bracket_pair`] for particle `i` against up to [`LANES`] neighbours `js` at once, when no
-/// axis is short, through the branch-free batch kernel [`contact_brackets`]. On return, for
-/// each `k < js.len()`: if [`predict_pair`] gives `Some(t)` for the pair, then
-/// `lo[k] ≤ max(t, now) ≤ hi[k]` (absolute times); `lo[k] = +∞` when it gives `None` (or a
-/// time that itself overflows to `+∞`, so a caller searching up to an infinite bound still
-/// asks [`predict_pair`]).
+/// [`bracket_pair`] for particle `i` against the neighbours `js[..len]` (up to [`LANES`])
+/// at once, when no axis is short, through the branch-free batch kernel
+/// [`contact_brackets`]. On return, for each `k < len`: if [`predict_pair`] gives `Some(t)`
+/// for the pair, then `lo[k] ≤ max(t, now) ≤ hi[k]` (absolute times); `lo[k] = +∞` when it
+/// gives `None` (or a time that itself overflows to `+∞`, so a caller searching up to an
+/// infinite bound still asks [`predict_pair`]). Lanes `k ≥ len` give `[+∞, +∞]` whatever
+/// `js[k]` holds, so a caller can always pass full chunks.
 /// The balls are exactly those [`bracket_pair`] would form, so the certified intervals are
 /// the same to the bit.
 #[inline]
+#[allow(clippy::too_many_arguments)]
 pub fn bracket_neighbours<const D: usize>(
     particles: &[Particle<D>],
     i: usize,
-    js: &[u32],
+    js: &[u32; LANES],
+    len: usize,
     sim_box: &SimBox<D>,
     now: f64,
     lo: &mut [f64; LANES],
@@ -254,9 +257,13 @@ pub fn bracket_neighbours<const D: usize>(
     let mut second = BallLanes::<D, LANES>::default();
     let mut t0 = [0.0; LANES];
     let p = &particles[i];
+    // Every lane is built (the unused ones pair `i` with itself), so the loop count is fixed.
     for (k, &j) in js.iter().enumerate() {
-        let q = &particles[j as usize];
-        let (a, b) = if i < j as usize { (p, q) } else { (q, p) };
+        let j = std::hint::select_unpredictable(k < len, j as usize, i);
+        let q = &particles[j];
+        // Lower index first; which one that is, is a coin toss across a particle's lanes.
+        let i_first = i < j;
+        let (a, b) = (std::hint::select_unpredictable(i_first, p, q), std::hint::select_unpredictable(i_first, q, p));
         let (a, b, t) = pair_balls(a, b, sim_box, now);
         first.set(k, &a);
         second.set(k, &b);
@@ -264,8 +271,9 @@ pub fn bracket_neighbours<const D: usize>(
     }
     contact_brackets(&first, &second, lo, hi);
     for k in 0..LANES {
-        lo[k] = (t0[k] + lo[k]).max(now);
-        hi[k] = (t0[k] + hi[k]).max(now);
+        let used = k < len;
+        lo[k] = if used { (t0[k] + lo[k]).max(now) } else { f64::INFINITY };
+        hi[k] = if used { (t0[k] + hi[k]).max(now) } else { f64::INFINITY };
     }
 }
 
