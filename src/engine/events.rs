@@ -6,7 +6,7 @@
 //! always give the same event time to the last bit — whichever engine asks, and whenever.
 
 use super::collision::{Body, Impulse, Restitution, resolve_pair};
-use super::geometry::{Boundary, Particle, SimBox};
+use super::geometry::{Boundary, Particle, SimBox, image_count, image_count_by_comparison};
 use nalgebra::SVector;
 use quadratic::{Ball, BallLanes, Bracket, Contact, contact_bracket, contact_brackets, contact_time_within};
 use serde::{Deserialize, Serialize};
@@ -239,8 +239,13 @@ pub const LANES: usize = 8;
 /// gives `None` (or a time that itself overflows to `+∞`, so a caller searching up to an
 /// infinite bound still asks [`predict_pair`]). Lanes `k ≥ len` give `[+∞, +∞]` whatever
 /// `js[k]` holds, so a caller can always pass full chunks.
-/// The balls are exactly those [`bracket_pair`] would form, so the certified intervals are
-/// the same to the bit.
+///
+/// The balls are exactly those [`pair_balls`] forms (so the certified intervals are
+/// [`bracket_pair`]'s to the bit), but built lane by lane without branches: the neighbours'
+/// states are gathered first, then the positions, image counts and the order of the pair
+/// (lower index first) are computed for all lanes at once as selects, which the compiler
+/// vectorizes. Built one pair at a time, the lanes cost twice what the kernel did (profile at
+/// N = 10⁴, η = 0.65).
 #[inline]
 #[allow(clippy::too_many_arguments)]
 pub fn bracket_neighbours<const D: usize>(
@@ -253,21 +258,66 @@ pub fn bracket_neighbours<const D: usize>(
     lo: &mut [f64; LANES],
     hi: &mut [f64; LANES],
 ) {
+    let p = &particles[i];
+    let last = particles.len() - 1;
+    // Gather: the neighbours' states, one lane each (unused lanes pair `i` with itself).
+    let mut qx = [[0.0; LANES]; D];
+    let mut qv = [[0.0; LANES]; D];
+    let mut qt = [0.0; LANES];
+    let mut qr = [0.0; LANES];
+    let mut i_first = [false; LANES];
+    for k in 0..LANES {
+        let j = std::hint::select_unpredictable(k < len, js[k] as usize, i).min(last);
+        let q = &particles[j];
+        for a in 0..D {
+            qx[a][k] = q.position[a];
+            qv[a][k] = q.velocity[a];
+        }
+        qt[k] = q.time;
+        qr[k] = q.radius;
+        i_first[k] = i < j;
+    }
+    // The balls, as `pair_balls` forms them: `base` from the separation at `now` (lower index
+    // to higher; `P − Q` is exactly `−(Q − P)`), positions at `t0`, the later update time.
     let mut first = BallLanes::<D, LANES>::default();
     let mut second = BallLanes::<D, LANES>::default();
     let mut t0 = [0.0; LANES];
-    let p = &particles[i];
-    // Every lane is built (the unused ones pair `i` with itself), so the loop count is fixed.
-    for (k, &j) in js.iter().enumerate() {
-        let j = std::hint::select_unpredictable(k < len, j as usize, i);
-        let q = &particles[j];
-        // Lower index first; which one that is, is a coin toss across a particle's lanes.
-        let i_first = i < j;
-        let (a, b) = (std::hint::select_unpredictable(i_first, p, q), std::hint::select_unpredictable(i_first, q, p));
-        let (a, b, t) = pair_balls(a, b, sim_box, now);
-        first.set(k, &a);
-        second.set(k, &b);
+    let mut separation = [[0.0; LANES]; D];
+    let mut higher = [[0.0; LANES]; D];
+    let mut decided = [[true; LANES]; D];
+    for k in 0..LANES {
+        let t = p.time.max(qt[k]);
         t0[k] = t;
+        let ij = i_first[k];
+        for a in 0..D {
+            let e = (qx[a][k] + qv[a][k] * (now - qt[k])) - (p.position[a] + p.velocity[a] * (now - p.time));
+            let d = if ij { e } else { -e };
+            let (count, known) = image_count_by_comparison(d, sim_box.lengths[a]);
+            let periodic = sim_box.boundary[a] == Boundary::Periodic;
+            let count = if periodic { count } else { 0.0 };
+            let p_at = p.position[a] + p.velocity[a] * (t - p.time);
+            let q_at = qx[a][k] + qv[a][k] * (t - qt[k]);
+            first.position[a][k] = if ij { p_at } else { q_at };
+            higher[a][k] = if ij { q_at } else { p_at };
+            second.position[a][k] = higher[a][k] + count * sim_box.lengths[a];
+            first.velocity[a][k] = if ij { p.velocity[a] } else { qv[a][k] };
+            second.velocity[a][k] = if ij { qv[a][k] } else { p.velocity[a] };
+            separation[a][k] = d;
+            decided[a][k] = known | !periodic;
+        }
+        first.radius[k] = if ij { p.radius } else { qr[k] };
+        second.radius[k] = if ij { qr[k] } else { p.radius };
+    }
+    // A separation near half a box length (or beyond 3/2) needs the division: rare.
+    if decided.iter().flatten().any(|&known| !known) {
+        for a in 0..D {
+            for k in 0..LANES {
+                if !decided[a][k] {
+                    let count = image_count(separation[a][k], sim_box.lengths[a]);
+                    second.position[a][k] = higher[a][k] + count * sim_box.lengths[a];
+                }
+            }
+        }
     }
     contact_brackets(&first, &second, lo, hi);
     for k in 0..LANES {

@@ -77,7 +77,7 @@ impl<const D: usize> SimBox<D> {
 }
 
 /// `−round(x/l)` for `l > 0` (see [`SimBox::minimum_image_count`]).
-fn image_count(x: f64, l: f64) -> f64 {
+pub(crate) fn image_count(x: f64, l: f64) -> f64 {
     let ax = x.abs();
     if ax < 0.49 * l {
         -(0.0f64.copysign(x))
@@ -86,6 +86,18 @@ fn image_count(x: f64, l: f64) -> f64 {
     } else {
         -(x / l).round()
     }
+}
+
+/// [`image_count`]'s two cases decided by comparisons, as selects (for vector lanes): the
+/// count, and whether it holds — if not, `|x|` is near `L/2` or beyond `3L/2`, and the count
+/// is [`image_count`]'s division.
+#[inline(always)]
+pub(crate) fn image_count_by_comparison(x: f64, l: f64) -> (f64, bool) {
+    let ax = x.abs();
+    let small = ax < 0.49 * l;
+    let one = ax > 0.51 * l && ax < 1.49 * l;
+    let count = if small { -(0.0f64.copysign(x)) } else { -(1.0f64.copysign(x)) };
+    (count, small | one)
 }
 
 /// One hard disk (sphere): its state at its own last-update time.
