@@ -98,11 +98,25 @@ impl EventQueue {
 
     /// The earliest event below internal node `k`, from its four children: two independent
     /// pairs, then their winners.
+    ///
+    /// The four children are all leaves (the level above the slots) or all internal nodes,
+    /// except under at most one node; the two common cases read them as one slice each.
     #[inline(always)]
     fn children_winner(&self, k: usize) -> Node {
         let c = ARITY * k + 1;
-        let (a, b) =
-            (self.earlier(self.winner(c), self.winner(c + 1)), self.earlier(self.winner(c + 2), self.winner(c + 3)));
+        let m = self.nodes.len();
+        let [w, x, y, z] = if c >= m {
+            let first = c - m;
+            let s = &self.pending[first..first + ARITY];
+            let leaf = |o: usize| Node { time: s[o].time, owner: (first + o) as u32 };
+            [leaf(0), leaf(1), leaf(2), leaf(3)]
+        } else if c + ARITY <= m {
+            let s = &self.nodes[c..c + ARITY];
+            [s[0], s[1], s[2], s[3]]
+        } else {
+            [self.winner(c), self.winner(c + 1), self.winner(c + 2), self.winner(c + 3)]
+        };
+        let (a, b) = (self.earlier(w, x), self.earlier(y, z));
         self.earlier(a, b)
     }
 
