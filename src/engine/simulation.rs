@@ -463,6 +463,30 @@ impl<const D: usize> Simulation<D> {
     /// brute-force reference). Short periodic axes and crowds of more than [`NEAR`]
     /// neighbours take the scalar search.
     fn predict(&mut self, i: usize, except: Option<usize>) {
+        let skip = except.unwrap_or(i);
+        let mut near = [0u32; NEAR];
+        let gathered = if self.batch { self.cells.gather(i, skip, &mut near) } else { None };
+        self.predict_among(i, skip, &near, gathered);
+    }
+
+    /// [`predict`](Self::predict) for both partners of a collision, `i` skipping `j`. Both
+    /// neighbour lists are gathered before either particle is searched: at large N a gather
+    /// is a chain of cache misses (the cell heads, the links, the next links), and two
+    /// independent chains one right after the other overlap.
+    fn predict_partners(&mut self, i: usize, j: usize) {
+        let (mut near_i, mut near_j) = ([0u32; NEAR], [0u32; NEAR]);
+        let (gathered_i, gathered_j) = if self.batch {
+            (self.cells.gather(i, j, &mut near_i), self.cells.gather(j, j, &mut near_j))
+        } else {
+            (None, None)
+        };
+        self.predict_among(i, j, &near_i, gathered_i);
+        self.predict_among(j, j, &near_j, gathered_j);
+    }
+
+    /// The rest of [`predict`](Self::predict), given particle `i`'s gathered neighbours
+    /// (`None`: not gathered, search one pair at a time).
+    fn predict_among(&mut self, i: usize, skip: usize, near: &[u32; NEAR], gathered: Option<usize>) {
         let p = &self.particles[i];
         let now = self.time;
         let owner = i as u32;
@@ -480,9 +504,6 @@ impl<const D: usize> Simulation<D> {
             let t = (p.time + dt).max(now);
             consider(&mut best, Pending { time: t, kind: PendingKind::Cell { axis: axis as u8, up } });
         }
-        let skip = except.unwrap_or(i);
-        let mut near = [0u32; NEAR];
-        let gathered = if self.batch { self.cells.gather(i, skip, &mut near) } else { None };
         if let Some(n_near) = gathered {
             // Pass 1: bracket the neighbours LANES at a time (branch-free); `bound` is the
             // earliest time some candidate is certain to reach. Every chunk is LANES wide (the
@@ -616,8 +637,7 @@ impl<const D: usize> Simulation<D> {
                     self.counts.pair += 1;
                     let (i, j) = if owner < partner { (owner, partner) } else { (partner, owner) };
                     let impulse = resolve_pair_event(&mut self.particles, i, j, &self.sim_box, t, self.restitution);
-                    self.predict(i, Some(j));
-                    self.predict(j, None);
+                    self.predict_partners(i, j);
                     return Some(Outcome::Pair { i, j, impulse });
                 }
                 PendingKind::Wall { axis, upper } => {
