@@ -78,19 +78,16 @@ impl<const D: usize> SimBox<D> {
 
 /// `−round(x/l)` for `l > 0` (see [`SimBox::minimum_image_count`]).
 pub(crate) fn image_count(x: f64, l: f64) -> f64 {
-    let ax = x.abs();
-    if ax < 0.49 * l {
-        -(0.0f64.copysign(x))
-    } else if ax > 0.51 * l && ax < 1.49 * l {
-        -(1.0f64.copysign(x))
-    } else {
-        -(x / l).round()
+    match image_count_by_comparison(x, l) {
+        (count, true) => count,
+        _ => -(x / l).round(),
     }
 }
 
-/// [`image_count`]'s two cases decided by comparisons, as selects (for vector lanes): the
-/// count, and whether it holds — if not, `|x|` is near `L/2` or beyond `3L/2`, and the count
-/// is [`image_count`]'s division.
+/// [`image_count`] where comparisons decide it, as selects (so that vector lanes can use it):
+/// `|x| < fl(0.49·l)` gives 0 and `fl(0.51·l) < |x| < fl(1.49·l)` gives 1, with the sign of
+/// `−x`; the flag says whether one of them held — if not, `|x|` is near `l/2` or beyond
+/// `3l/2`, and the count takes the division.
 #[inline(always)]
 pub(crate) fn image_count_by_comparison(x: f64, l: f64) -> (f64, bool) {
     let ax = x.abs();
