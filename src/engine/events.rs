@@ -238,7 +238,7 @@ pub const LANES: usize = 8;
 /// for the pair, then `lo[k] ≤ max(t, now) ≤ hi[k]` (absolute times); `lo[k] = +∞` when it
 /// gives `None` (or a time that itself overflows to `+∞`, so a caller searching up to an
 /// infinite bound still asks [`predict_pair`]). Lanes `k ≥ len` give `[+∞, +∞]` whatever
-/// `js[k]` holds, so a caller can always pass full chunks.
+/// `js[k]` holds, so a caller can always pass full chunks. Returns the smallest `hi[k]`.
 ///
 /// The balls are exactly those [`pair_balls`] forms (so the certified intervals are
 /// [`bracket_pair`]'s to the bit), but built lane by lane without branches: the neighbours'
@@ -257,7 +257,7 @@ pub fn bracket_neighbours<const D: usize>(
     now: f64,
     lo: &mut [f64; LANES],
     hi: &mut [f64; LANES],
-) {
+) -> f64 {
     let p = &particles[i];
     let last = particles.len() - 1;
     // Gather: the neighbours' states, one lane each (unused lanes pair `i` with itself).
@@ -325,6 +325,18 @@ pub fn bracket_neighbours<const D: usize>(
         lo[k] = if used { (t0[k] + lo[k]).max(now) } else { f64::INFINITY };
         hi[k] = if used { (t0[k] + hi[k]).max(now) } else { f64::INFINITY };
     }
+    // Pairwise, while the ends are still in registers (a fold over the stored array was a
+    // serial chain of minima behind store-to-load forwarding).
+    const { assert!(LANES.is_power_of_two()) };
+    let mut m = *hi;
+    let mut width = LANES;
+    while width > 1 {
+        width /= 2;
+        for k in 0..width {
+            m[k] = m[k].min(m[k + width]);
+        }
+    }
+    m[0]
 }
 
 /// The two balls the kernel is given for a pair when no axis is short: positions at `t0`,
