@@ -483,8 +483,14 @@ impl<const D: usize> Simulation<D> {
     fn predict(&mut self, i: usize, except: Option<usize>) {
         let skip = except.unwrap_or(i);
         let mut near = [0u32; NEAR];
-        let gathered = if self.batch { self.cells.gather(i, skip, &mut near) } else { None };
+        let gathered = self.gather(i, skip, &mut near);
         self.predict_among(i, skip, &near, gathered);
+    }
+
+    /// Particle `i`'s neighbours but `skip`, for the batch search: how many, or `None` when
+    /// the batch cannot take them (short axes, or more than [`NEAR`]).
+    fn gather(&self, i: usize, skip: usize, near: &mut [u32; NEAR]) -> Option<usize> {
+        if self.batch { self.cells.gather(i, skip, near) } else { None }
     }
 
     /// [`predict`](Self::predict) for both partners of a collision, `i` skipping `j`. Both
@@ -493,11 +499,7 @@ impl<const D: usize> Simulation<D> {
     /// independent chains one right after the other overlap.
     fn predict_partners(&mut self, i: usize, j: usize) {
         let (mut near_i, mut near_j) = ([0u32; NEAR], [0u32; NEAR]);
-        let (gathered_i, gathered_j) = if self.batch {
-            (self.cells.gather(i, j, &mut near_i), self.cells.gather(j, j, &mut near_j))
-        } else {
-            (None, None)
-        };
+        let (gathered_i, gathered_j) = (self.gather(i, j, &mut near_i), self.gather(j, j, &mut near_j));
         self.predict_among(i, j, &near_i, gathered_i);
         self.predict_among(j, j, &near_j, gathered_j);
     }
