@@ -39,7 +39,7 @@
 //! assert_eq!(b.velocity, vector![1.0, 0.0]);
 //! assert_eq!(impulse.virial(), 2.0); // σ·|Δp| with σ = 1, |Δp| = 2
 //! ```
-#![forbid(unsafe_code)]
+#![deny(unsafe_code)]
 #![warn(missing_docs)]
 
 pub mod engine;

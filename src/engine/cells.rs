@@ -234,6 +234,32 @@ impl<const D: usize> Cells<D> {
         around
     }
 
+    /// Prefetches particle `i`'s cell coordinate.
+    #[inline]
+    pub fn prefetch_coord(&self, i: usize) {
+        super::prefetch::prefetch(&self.coords[i]);
+    }
+
+    /// Prefetches the heads of the cells around particle `i`.
+    #[inline]
+    pub fn prefetch_heads(&self, around: &Around) {
+        for &c in around.as_slice() {
+            super::prefetch::prefetch(&self.head[c as usize]);
+        }
+    }
+
+    /// Prefetches the first member of each cell around particle `i`, and its link.
+    #[inline]
+    pub fn prefetch_members<T>(&self, around: &Around, records: &[T]) {
+        for &c in around.as_slice() {
+            let j = self.head[c as usize];
+            if j != NONE {
+                super::prefetch::prefetch(&self.next[j as usize]);
+                super::prefetch::prefetch(&records[j as usize]);
+            }
+        }
+    }
+
     /// The particles in cell `c` (a flat index from [`Cells::around`]).
     #[inline]
     pub fn members(&self, c: u32) -> Members<'_> {

@@ -16,6 +16,7 @@ pub mod collision;
 pub mod events;
 pub mod geometry;
 pub mod init;
+mod prefetch;
 pub mod queue;
 pub mod reference;
 pub mod simulation;
