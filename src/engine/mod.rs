@@ -7,6 +7,7 @@
 //! * [`events`]: event types, their total order, the pure predictions.
 //! * [`cells`]: the cell grid.
 //! * [`queue`]: one pending event per particle, in a tournament tree.
+//! * `prefetch`: the cache hint of the lookahead (the crate's one `unsafe` block).
 //! * [`simulation`]: the event loop.
 //! * [`reference`]: the O(N²) reference.
 //! * [`init`]: initial states (lattices, random placement, Maxwell or fixed-speed velocities).

@@ -16,7 +16,7 @@
 //! the pair's contact and coming up re-covers it. The brute-force
 //! [`ReferenceSimulation`](super::ReferenceSimulation) checks this bit for bit.
 
-use super::cells::Cells;
+use super::cells::{Around, Cells};
 use super::collision::{Impulse, Restitution};
 use super::events::{
     LANES, PairBracket, Pending, PendingKind, SAMPLE_RANK, bracket_neighbours, bracket_pair, pair_positions,
@@ -221,6 +221,12 @@ pub struct Simulation<const D: usize> {
     brackets: Brackets,
     /// Prefetch the data of the next event while processing a collision (large N only).
     lookahead: bool,
+}
+
+/// The cells around the next event's particles, between the lookahead's stages.
+struct Ahead {
+    around: [Around; 2],
+    count: usize,
 }
 
 /// Lower and upper ends of the brackets of up to [`NEAR`] neighbours.
@@ -493,6 +499,19 @@ impl<const D: usize> Simulation<D> {
         self.predict_among(i, skip, &near, gathered);
     }
 
+    /// [`predict`](Self::predict) for the owner of a marker or a cell crossing, prefetching
+    /// for the event expected next (as [`predict_partners`](Self::predict_partners) does).
+    fn predict_alone(&mut self, i: usize) {
+        let next = self.lookahead.then(|| self.prefetch_next(i, i));
+        let mut near = [0u32; NEAR];
+        let gathered = self.gather(i, i, &mut near);
+        let ahead = next.map(|next| self.prefetch_neighbourhood(next));
+        self.predict_among(i, i, &near, gathered);
+        if let Some(ahead) = &ahead {
+            self.prefetch_members(ahead);
+        }
+    }
+
     /// Particle `i`'s neighbours but `skip`, for the batch search: how many, or `None` when
     /// the batch cannot take them (short axes, or more than [`NEAR`]).
     fn gather(&self, i: usize, skip: usize, near: &mut [u32; NEAR]) -> Option<usize> {
@@ -516,20 +535,10 @@ impl<const D: usize> Simulation<D> {
     fn predict_partners(&mut self, i: usize, j: usize, next: Option<usize>) {
         let (mut near_i, mut near_j) = ([0u32; NEAR], [0u32; NEAR]);
         let (gathered_i, gathered_j) = (self.gather(i, j, &mut near_i), self.gather(j, j, &mut near_j));
-        let around_next = next.map(|next| {
-            let around = self.cells.around(next);
-            self.cells.prefetch_heads(&around);
-            self.queue.prefetch_path(next);
-            if let PendingKind::Pair { partner, .. } = self.queue.get(next).kind {
-                prefetch(&self.particles[partner as usize]);
-                self.cells.prefetch_coord(partner as usize);
-                self.queue.prefetch_path(partner as usize);
-            }
-            around
-        });
+        let ahead = next.map(|next| self.prefetch_neighbourhood(next));
         self.predict_among(i, j, &near_i, gathered_i);
-        if let Some(around) = around_next {
-            self.cells.prefetch_members(&around, &self.particles);
+        if let Some(ahead) = &ahead {
+            self.prefetch_members(ahead);
         }
         self.predict_among(j, j, &near_j, gathered_j);
     }
@@ -544,6 +553,31 @@ impl<const D: usize> Simulation<D> {
         prefetch(self.queue.get(next));
         self.cells.prefetch_coord(next);
         next
+    }
+
+    /// The second stage of the lookahead: the heads of the cells around `next` and of those
+    /// around its partner, the lowest levels of both tree paths, the partner's record.
+    fn prefetch_neighbourhood(&self, next: usize) -> Ahead {
+        let mut ahead = Ahead { around: [self.cells.around(next), self.cells.around(next)], count: 1 };
+        self.queue.prefetch_path(next);
+        if let PendingKind::Pair { partner, .. } = self.queue.get(next).kind {
+            let partner = partner as usize;
+            prefetch(&self.particles[partner]);
+            self.queue.prefetch_path(partner);
+            ahead.around[1] = self.cells.around(partner);
+            ahead.count = 2;
+        }
+        for around in &ahead.around[..ahead.count] {
+            self.cells.prefetch_heads(around);
+        }
+        ahead
+    }
+
+    /// The third stage: the first member of each of those cells, and its link.
+    fn prefetch_members(&self, ahead: &Ahead) {
+        for around in &ahead.around[..ahead.count] {
+            self.cells.prefetch_members(around, &self.particles);
+        }
     }
 
     /// The rest of [`predict`](Self::predict), given particle `i`'s gathered neighbours
@@ -693,7 +727,7 @@ impl<const D: usize> Simulation<D> {
                         // The partner changed course: a marker. Predict the owner again, from
                         // the clock of the last real event (the marker is no event).
                         self.counts.stale += 1;
-                        self.predict(owner, None);
+                        self.predict_alone(owner);
                         continue;
                     }
                     self.time = t;
@@ -717,7 +751,7 @@ impl<const D: usize> Simulation<D> {
                     self.counts.cell += 1;
                     self.cells.shift(owner, axis as usize, up);
                     // Same velocity, new neighbours: predict again over the new cells.
-                    self.predict(owner, None);
+                    self.predict_alone(owner);
                     return Some(Outcome::Cell);
                 }
             }
