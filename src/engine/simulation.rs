@@ -772,8 +772,9 @@ impl<const D: usize> Simulation<D> {
 /// Whether prefetching the next event's data pays for finding it: from about 4 MiB of
 /// engine state on. Finding the next event and issuing the prefetches costs about 1 900
 /// instructions per collision (callgrind, N = 10⁴, η = 0.65), which only memory misses
-/// repay: alternating runs at η = 0.65 measured the lookahead 10 % slower at N = 3·10⁴,
-/// 12 % faster at 4·10⁴ and 20–60 % faster at 10⁵ and 10⁶ (README, Benchmarks).
+/// repay: alternating runs at η = 0.65 measured its first version (after collisions only)
+/// 10 % slower at N = 3·10⁴, 12 % faster at 4·10⁴ and 30–50 % faster at 10⁵ and 10⁶
+/// (README, Benchmarks).
 fn lookahead_pays(n: usize) -> bool {
     n >= LOOKAHEAD_FROM
 }
