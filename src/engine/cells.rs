@@ -240,7 +240,7 @@ impl<const D: usize> Cells<D> {
         super::prefetch::prefetch(&self.coords[i]);
     }
 
-    /// Prefetches the heads of the cells around particle `i`.
+    /// Prefetches the heads of the cells `around` (from [`Cells::around`]).
     #[inline]
     pub fn prefetch_heads(&self, around: &Around) {
         for &c in around.as_slice() {
@@ -248,7 +248,8 @@ impl<const D: usize> Cells<D> {
         }
     }
 
-    /// Prefetches the first member of each cell around particle `i`, and its link.
+    /// Prefetches the first member of each of the cells `around`, from `records` (one per
+    /// particle), and its link (the heads should already be in cache).
     #[inline]
     pub fn prefetch_members<T>(&self, around: &Around, records: &[T]) {
         for &c in around.as_slice() {
