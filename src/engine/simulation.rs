@@ -268,6 +268,7 @@ impl<const D: usize> Simulation<D> {
         particles.shrink_to_fit();
         let cells = Cells::new(&sim_box, reach, particles.iter().map(|p| p.position_at(p.time)));
         let time = particles.iter().map(|p| p.time).fold(f64::NEG_INFINITY, f64::max);
+        let n = particles.len();
         let mut sim = Simulation {
             queue: EventQueue::new(vec![Pending::NOTHING; particles.len()]),
             particles,
@@ -281,9 +282,8 @@ impl<const D: usize> Simulation<D> {
             next_sample: None,
             batch: false,
             brackets: Brackets::default(),
-            lookahead: false,
+            lookahead: lookahead_pays(n),
         };
-        sim.lookahead = lookahead_pays(sim.particles.len());
         sim.batch = !sim.short.contains(&true);
         if let Some(audit) = sim.overlap_beyond(0.0) {
             let (i, j) = audit.at.expect("an overlap has a place");
@@ -527,9 +527,10 @@ impl<const D: usize> Simulation<D> {
     /// [`prefetch_next`](Self::prefetch_next), which has already asked for its record and
     /// cell coordinate). Its neighbourhood is then prefetched in two stages, each a few
     /// hundred nanoseconds ahead of its use, so that no stage waits for the one before: here
-    /// the heads of its cells, the lowest levels of its tree path, and its partner's record;
-    /// between the two predictions (when the heads have arrived) the first member of each
-    /// cell and its link. At N = 10⁵ these were most of the cache misses of a collision
+    /// ([`prefetch_neighbourhood`](Self::prefetch_neighbourhood)) the heads of the cells
+    /// around it and its partner, the lowest levels of both tree paths and the partner's
+    /// record; between the two predictions (when the heads have arrived) the first member of
+    /// each of those cells and its link. At N = 10⁵ these were most of the cache misses of a collision
     /// (cachegrind with a 1 MB last-level cache: of 37 misses per collision, 13 in the
     /// neighbours' records, 8 in the cell lists, 7 in the tree, 3 in the event's own data).
     fn predict_partners(&mut self, i: usize, j: usize, next: Option<usize>) {
@@ -558,7 +559,8 @@ impl<const D: usize> Simulation<D> {
     /// The second stage of the lookahead: the heads of the cells around `next` and of those
     /// around its partner, the lowest levels of both tree paths, the partner's record.
     fn prefetch_neighbourhood(&self, next: usize) -> Ahead {
-        let mut ahead = Ahead { around: [self.cells.around(next), self.cells.around(next)], count: 1 };
+        let around = self.cells.around(next);
+        let mut ahead = Ahead { around: [around, around], count: 1 };
         self.queue.prefetch_path(next);
         if let PendingKind::Pair { partner, .. } = self.queue.get(next).kind {
             let partner = partner as usize;
