@@ -20,7 +20,7 @@ pub enum EventKind {
         /// The partner (always greater than the event's `i`).
         j: usize,
         /// The partner's event counter at prediction.
-        j_events: u64,
+        j_events: u32,
     },
     /// Particle `i` hits the wall at the `upper` or lower end of `axis`.
     Wall {
@@ -59,7 +59,7 @@ pub struct Event {
     /// The (lower-index) particle; `usize::MAX` for samples.
     pub i: usize,
     /// Particle `i`'s event counter at prediction.
-    pub i_events: u64,
+    pub i_events: u32,
     /// What.
     pub kind: EventKind,
 }
@@ -410,7 +410,7 @@ pub fn resolve_pair_event<const D: usize>(
     let impulse = resolve_pair(&mut a, &mut b, restitution);
     for (k, body) in [(i, a), (j, b)] {
         particles[k].velocity = body.velocity;
-        particles[k].events += 1;
+        particles[k].events = particles[k].events.wrapping_add(1);
     }
     impulse
 }
@@ -421,7 +421,7 @@ pub fn resolve_pair_event<const D: usize>(
 pub fn resolve_wall_event<const D: usize>(p: &mut Particle<D>, axis: usize, upper: bool, t: f64) -> f64 {
     p.advance(t);
     let v = p.velocity[axis];
-    p.events += 1;
+    p.events = p.events.wrapping_add(1);
     if v != 0.0 && (v > 0.0) == upper {
         p.velocity[axis] = -v;
         2.0 * p.mass * v.abs()
@@ -455,7 +455,7 @@ pub enum PendingKind {
         /// The other particle.
         partner: u32,
         /// Its event counter at prediction.
-        partner_events: u64,
+        partner_events: u32,
     },
     /// The owner hits the `upper` or lower wall of `axis`.
     Wall {

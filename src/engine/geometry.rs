@@ -102,7 +102,13 @@ pub(crate) fn image_count_by_comparison(x: f64, l: f64) -> (f64, bool) {
 /// Positions are stored *unwrapped* at time `time` and advanced lazily: the position at any
 /// `t` is `position + velocity·(t − time)`. Periodic images are tracked by the cell grid,
 /// so a position is never shifted by a box length (which would round).
+///
+/// In 2D a record is 64 bytes and aligned to 64: exactly one cache line, so that reading a
+/// neighbour (or prefetching it) costs one line where the 72-byte record it replaced
+/// straddled two (measured: +10 % collisions/s at N = 10⁵, η = 0.65; README, Benchmarks).
+/// In 3D it takes two lines (80 bytes, padded to 128).
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[repr(C, align(64))]
 pub struct Particle<const D: usize> {
     /// Position at `time`.
     pub position: SVector<f64, D>,
@@ -115,11 +121,16 @@ pub struct Particle<const D: usize> {
     /// Mass (> 0).
     pub mass: f64,
     /// Species index (into the configuration's species list).
-    pub species: usize,
-    /// Event counter: incremented whenever the velocity changes; an event predicted with an
-    /// older count is stale.
-    pub events: u64,
+    pub species: u32,
+    /// Event counter: incremented (modulo 2³²) whenever the velocity changes; an event
+    /// predicted with another count is stale. A counter that wraps to 0 makes the
+    /// [`Simulation`](super::Simulation) predict every particle again, so that no pending
+    /// event can outlive 2³² changes of its partner and take it for none.
+    pub events: u32,
 }
+
+// One cache line per disk (see `Particle`).
+const _: () = assert!(size_of::<Particle<2>>() == 64);
 
 impl<const D: usize> Particle<D> {
     /// Position at time `t`.

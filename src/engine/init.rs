@@ -188,7 +188,7 @@ pub fn initial_particles(
             time: 0.0,
             radius: species[k].radius,
             mass: species[k].mass,
-            species: k,
+            species: k as u32,
             events: 0,
         })
         .collect();

@@ -737,7 +737,11 @@ impl<const D: usize> Simulation<D> {
                     let (i, j) = if owner < partner { (owner, partner) } else { (partner, owner) };
                     let next = self.lookahead.then(|| self.prefetch_next(i, j));
                     let impulse = resolve_pair_event(&mut self.particles, i, j, &self.sim_box, t, self.restitution);
-                    self.predict_partners(i, j, next);
+                    if self.particles[i].events == 0 || self.particles[j].events == 0 {
+                        self.predict_everyone();
+                    } else {
+                        self.predict_partners(i, j, next);
+                    }
                     return Some(Outcome::Pair { i, j, impulse });
                 }
                 PendingKind::Wall { axis, upper } => {
@@ -745,7 +749,11 @@ impl<const D: usize> Simulation<D> {
                     self.counts.wall += 1;
                     let axis = axis as usize;
                     let impulse = resolve_wall_event(&mut self.particles[owner], axis, upper, t);
-                    self.predict(owner, None);
+                    if self.particles[owner].events == 0 {
+                        self.predict_everyone();
+                    } else {
+                        self.predict(owner, None);
+                    }
                     return Some(Outcome::Wall { i: owner, axis, upper, impulse });
                 }
                 PendingKind::Cell { axis, up } => {
@@ -757,6 +765,20 @@ impl<const D: usize> Simulation<D> {
                     return Some(Outcome::Cell);
                 }
             }
+        }
+    }
+
+    /// Predicts every particle again: after an event counter wrapped to 0 (once per 2³²
+    /// velocity changes of one particle). A pending event recorded its partner's count at
+    /// prediction; were it to survive until the partner had changed course a multiple of 2³²
+    /// times, the counts would match and a stale event would be taken for a live one. Fresh
+    /// predictions record the current counts, so none spans a wrap. The collisions are the
+    /// same either way (predictions are exact); only re-prediction markers go.
+    #[cold]
+    #[inline(never)]
+    fn predict_everyone(&mut self) {
+        for k in 0..self.particles.len() {
+            self.predict(k, None);
         }
     }
 
@@ -886,6 +908,50 @@ mod tests {
             assert_eq!(batch.particles(), scalar.particles());
             assert!(batch.counts().pair > 10_000, "{:?}", batch.counts());
         }
+    }
+
+    /// Event counters are 32-bit and wrap: with every counter started a few events short of
+    /// the wrap, the collisions are those of the same system counting from 0, and right
+    /// after any counter wraps no pending event holds a count its partner no longer has
+    /// (without the re-prediction, events predicted before the wrap would).
+    #[test]
+    fn wrapping_event_counters_change_nothing() {
+        let plain = system(40, false);
+        let mut wrapping = plain.clone();
+        let mut rng = Xoshiro256PlusPlus::seed_from_u64(3);
+        for p in &mut wrapping.particles {
+            p.events = u32::MAX - rng.random_range(0..30);
+        }
+        wrapping.predict_everyone();
+        let (mut plain, mut wraps) = (plain, 0);
+        for _ in 0..20_000 {
+            let collision = |o: Option<Outcome<2>>| match o {
+                Some(Outcome::Pair { i, j, .. }) => Some((i, j)),
+                Some(Outcome::Wall { i, .. }) => Some((i, i)),
+                _ => None,
+            };
+            let expected = loop {
+                if let Some(c) = collision(plain.step()) {
+                    break (c, plain.time().to_bits());
+                }
+            };
+            let got = loop {
+                if let Some(c) = collision(wrapping.step()) {
+                    break (c, wrapping.time().to_bits());
+                }
+            };
+            assert_eq!(got, expected);
+            let ((i, j), _) = got;
+            if wrapping.particles[i].events == 0 || wrapping.particles[j].events == 0 {
+                wraps += 1;
+                for e in wrapping.queue.pending() {
+                    if let PendingKind::Pair { partner, partner_events } = e.kind {
+                        assert_eq!(partner_events, wrapping.particles[partner as usize].events);
+                    }
+                }
+            }
+        }
+        assert!(wraps > 1000, "{wraps} wraps");
     }
 
     /// The lookahead (on by default only from `LOOKAHEAD_FROM` particles) prefetches and

@@ -29,8 +29,8 @@ pub fn species_temperatures(sim: &Simulation<2>, species: usize) -> Vec<f64> {
     let mut k = vec![0.0; species];
     let mut dof = vec![0.0; species];
     for p in sim.particles() {
-        k[p.species] += p.kinetic_energy();
-        dof[p.species] += 2.0 * (1.0 - p.mass / total_mass);
+        k[p.species as usize] += p.kinetic_energy();
+        dof[p.species as usize] += 2.0 * (1.0 - p.mass / total_mass);
     }
     k.iter().zip(&dof).map(|(k, d)| 2.0 * k / d).collect()
 }
