@@ -362,7 +362,7 @@ impl<const D: usize> Simulation<D> {
         SimulationState {
             particles: self.particles.clone(),
             cells: self.cells.coords().iter().map(|m| m.to_vec()).collect(),
-            pending: self.queue.pending().to_vec(),
+            pending: self.queue.pending(),
             time: self.time,
             counts: self.counts,
             sampling: self.sampling,
@@ -551,7 +551,7 @@ impl<const D: usize> Simulation<D> {
     fn prefetch_next(&self, i: usize, j: usize) -> usize {
         let next = self.queue.runner_up(i, j);
         prefetch(&self.particles[next]);
-        prefetch(self.queue.get(next));
+        self.queue.prefetch_slot(next);
         self.cells.prefetch_coord(next);
         next
     }
@@ -714,7 +714,7 @@ impl<const D: usize> Simulation<D> {
     /// Processes the next event and reports it; `None` when nothing can happen any more.
     pub fn step(&mut self) -> Option<Outcome<D>> {
         loop {
-            let (owner, &next) = self.queue.first();
+            let (owner, next) = self.queue.first();
             if let Some(ts) = self.next_sample
                 && (ts < next.time || (ts == next.time && SAMPLE_RANK < next.key(owner as u32).0))
             {
@@ -967,7 +967,7 @@ mod tests {
         for _ in 0..20_000 {
             let guess = match ahead.queue.first() {
                 (i, Pending { kind: PendingKind::Pair { partner, .. }, .. }) => {
-                    Some(ahead.queue.runner_up(i, *partner as usize))
+                    Some(ahead.queue.runner_up(i, partner as usize))
                 }
                 _ => None,
             };
