@@ -1,6 +1,6 @@
 //! A cache hint: ask for the line holding a value before it is needed.
 //!
-//! The engine's lookahead (`Simulation`, from 2^15 particles on) uses it to load the next
+//! The engine's lookahead (`Simulation`, from 3·2^14 particles on) uses it to load the next
 //! event's data while the current one is processed. This is the crate's only `unsafe` code:
 //! `_mm_prefetch` takes a raw pointer, although a prefetch cannot fault, reads nothing into
 //! the program and writes nothing — results are the same bit for bit with or without it.

@@ -793,18 +793,20 @@ impl<const D: usize> Simulation<D> {
     }
 }
 
-/// Whether prefetching the next event's data pays for finding it: from about 4 MiB of
+/// Whether prefetching the next event's data pays for finding it: from about 6 MB of
 /// engine state on. Finding the next event and issuing the prefetches costs about 1 900
 /// instructions per collision (callgrind, N = 10⁴, η = 0.65), which only memory misses
-/// repay: alternating runs at η = 0.65 measured its first version (after collisions only)
-/// 10 % slower at N = 3·10⁴, 12 % faster at 4·10⁴ and 30–50 % faster at 10⁵ and 10⁶
-/// (README, Benchmarks).
+/// repay. Alternating runs at η = 0.65 (`benches/compare.sh`, medians of 4–8 runs, 10⁶/s),
+/// with 64-byte records and 16-byte events, on against off: 1.24 vs 1.62 at N = 10⁴, 1.14
+/// vs 1.35 at 2·10⁴, 1.09 vs 1.19 at 3·10⁴, 1.06 vs 1.14 at 4·10⁴; 1.02 vs 0.92 at
+/// 5.5·10⁴ and 0.98 vs 0.85 at 7·10⁴. (With the 72-byte records before, the crossover
+/// was between 3·10⁴ and 4·10⁴.)
 fn lookahead_pays(n: usize) -> bool {
     n >= LOOKAHEAD_FROM
 }
 
-/// The fewest particles for which [`lookahead_pays`].
-const LOOKAHEAD_FROM: usize = 1 << 15;
+/// The fewest particles for which [`lookahead_pays`]: 3·2¹⁴.
+const LOOKAHEAD_FROM: usize = 3 << 14;
 
 /// Checks particles and box; returns the largest contact distance (the cell "reach").
 fn validate<const D: usize>(particles: &[Particle<D>], sim_box: &SimBox<D>) -> Result<f64, SetupError> {
