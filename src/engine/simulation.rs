@@ -270,7 +270,7 @@ impl<const D: usize> Simulation<D> {
         let time = particles.iter().map(|p| p.time).fold(f64::NEG_INFINITY, f64::max);
         let n = particles.len();
         let mut sim = Simulation {
-            queue: EventQueue::new(vec![Pending::NOTHING; particles.len()]),
+            queue: EventQueue::nothing(particles.len()),
             particles,
             short: short_axes(&sim_box, reach),
             sim_box,
