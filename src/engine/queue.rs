@@ -117,10 +117,7 @@ impl EventQueue {
         for (p, e) in pending.into_iter().enumerate() {
             *queue.slot_mut(p) = Slot::pack(e);
         }
-        for k in (0..queue.m).rev() {
-            let best = queue.children_winner(k);
-            queue.set_node(k, best);
-        }
+        queue.build_nodes();
         queue
     }
 
@@ -136,8 +133,6 @@ impl EventQueue {
         // The children of node k begin at tree position 4k + 1, slot 4k + 1 − m.
         let shift = (m + ARITY - 1) % ARITY;
         let empty = Group([Slot::pack(Pending::NOTHING); ARITY]);
-        // The nodes are built even though every time is +∞: the winners of those ties are
-        // decided by the full key, as everywhere else.
         let mut queue = EventQueue {
             groups: vec![empty; (slots + shift).div_ceil(ARITY)],
             shift,
@@ -146,11 +141,18 @@ impl EventQueue {
             root: NO_NODE,
             quads: vec![Quad([NO_NODE; ARITY]); m.saturating_sub(1).div_ceil(ARITY)],
         };
-        for k in (0..m).rev() {
-            let best = queue.children_winner(k);
-            queue.set_node(k, best);
-        }
+        // Built even though every time is +∞: the winners of those ties are decided by the
+        // full key, as everywhere else.
+        queue.build_nodes();
         queue
+    }
+
+    /// Every internal node's winner, bottom up.
+    fn build_nodes(&mut self) {
+        for k in (0..self.m).rev() {
+            let best = self.children_winner(k);
+            self.set_node(k, best);
+        }
     }
 
     #[inline(always)]
