@@ -303,9 +303,7 @@ impl<const D: usize> Simulation<D> {
             }
             return Err(SetupError::Overlap { i, j, fraction: audit.fraction });
         }
-        for i in 0..sim.particles.len() {
-            sim.predict(i, None);
-        }
+        sim.predict_everyone();
         Ok(sim)
     }
 
@@ -768,8 +766,8 @@ impl<const D: usize> Simulation<D> {
         }
     }
 
-    /// Predicts every particle again: after an event counter wrapped to 0 (once per 2³²
-    /// velocity changes of one particle). A pending event recorded its partner's count at
+    /// Predicts every particle: at the start, and again after an event counter wrapped to 0
+    /// (once per 2³² velocity changes of one particle). A pending event recorded its partner's count at
     /// prediction; were it to survive until the partner had changed course a multiple of 2³²
     /// times, the counts would match and a stale event would be taken for a live one. Fresh
     /// predictions record the current counts, so none spans a wrap. The collisions are the
