@@ -1,9 +1,15 @@
-//! The cell grid: cells at least one contact distance wide, so that every possible
-//! collision partner of a particle is in its own or an adjacent cell.
+//! The cell grid, in one of two roles (see [`Neighbours`](super::neighbours::Neighbours)):
 //!
-//! Each particle carries an *unwrapped* integer cell coordinate per axis; along periodic
-//! axes it keeps counting past the box (that is how images are tracked without shifting
-//! positions). The wrapped coordinate selects the cell list.
+//! * **Following** the particles ([`Cells::follow`]): cells at least one contact distance
+//!   wide, each particle in the cell of its current position, so that every possible partner
+//!   is in its own or an adjacent cell. Each particle carries an *unwrapped* integer cell
+//!   coordinate per axis (along periodic axes it keeps counting past the box, which is how
+//!   its crossing times are computed from unwrapped positions), and the wrapped one that
+//!   selects the cell list. Leaving a cell is an event ([`Cells::next_crossing`],
+//!   [`Cells::shift`]).
+//! * Holding neighbour-list **centres** ([`Cells::new`]): cells at least one list range wide,
+//!   each particle in the cell of its centre, which moves only when the particle leaves its
+//!   skin. No coordinate is stored: [`Cells::locate`] finds it from the centre.
 
 use super::geometry::{Boundary, SimBox};
 use nalgebra::SVector;
@@ -11,31 +17,39 @@ use nalgebra::SVector;
 /// No particle / end of a cell list.
 const NONE: u32 = u32::MAX;
 
+/// A cell's coordinate, wrapped into the grid (axis by axis).
+pub type Coord<const D: usize> = [u32; D];
+
 /// Cell lists over the box, as intrusive singly linked lists: one head per cell and a `next`
 /// link per particle. Nothing allocates after construction, and the grid costs 4 bytes per
 /// particle plus 4 per cell — where a `Vec` per cell cost 24 bytes of header per cell and a
 /// heap block each (measured: 420–570 bytes per particle for the whole engine before).
-/// Removing a particle walks its cell's list, which holds about one particle (cells are one
-/// contact distance wide), so a back link would cost more memory than it saves time.
+/// Removing a particle walks its cell's list, which holds about one particle, so a back
+/// link would cost more memory than it saves time. Which cell a particle is in is not
+/// stored: the caller locates it from the particle's centre (the same function of the same
+/// number, so insertion and removal agree).
 #[derive(Clone, Debug)]
 pub struct Cells<const D: usize> {
     counts: [usize; D],
     widths: SVector<f64, D>,
+    /// `1 / width` per axis: locating a centre multiplies (the cell boundaries then sit
+    /// within an ulp of multiples of the width, which [`WIDTH_SLACK`] absorbs).
+    inverse: SVector<f64, D>,
     boundary: [Boundary; D],
     /// Flat-index stride of each axis (axis 0 fastest).
     strides: [usize; D],
     head: Vec<u32>,
     next: Vec<u32>,
-    /// Unwrapped cell coordinate of each particle.
+    /// Following: the unwrapped cell coordinate of each particle (else empty).
     coords: Vec<[i64; D]>,
-    /// The same, wrapped into the grid (`coords` modulo `counts`): the cells around a
-    /// particle are then found without a division (two per call cost more than the rest of
-    /// [`Cells::gather`]'s cell arithmetic; 8 bytes per particle in 2D).
-    wrapped: Vec<[u32; D]>,
+    /// Following: the same, wrapped into the grid (`coords` modulo `counts`; else empty). The
+    /// cells around a particle are then found without a division (two per call cost more
+    /// than the rest of [`Cells::gather`]'s cell arithmetic; 8 bytes per particle in 2D).
+    wrapped: Vec<Coord<D>>,
 }
 
-/// Relative slack on the cell width: a particle may sit a few ulps outside its cell (its
-/// crossing time is rounded), and must still be found by its neighbours' search.
+/// Relative slack on the cell width: a centre a few ulps from a cell boundary may be located
+/// on either side of it, and must still be found by its neighbours' search.
 const WIDTH_SLACK: f64 = 1e-9;
 
 /// The distinct cells around one cell (at most 3^D, D ≤ 3), as flat cell indices.
@@ -92,15 +106,17 @@ impl Stencil {
 }
 
 impl<const D: usize> Cells<D> {
-    /// A grid with cells at least `reach·(1 + 10⁻⁹)` wide, `reach` the largest contact
-    /// distance, holding the given positions.
-    pub fn new(sim_box: &SimBox<D>, reach: f64, positions: impl Iterator<Item = SVector<f64, D>>) -> Self {
+    /// A grid with cells at least `width·(1 + 10⁻⁹)` wide, holding particle `k` at the `k`-th
+    /// of `centres`.
+    pub fn new(sim_box: &SimBox<D>, width: f64, centres: impl Iterator<Item = SVector<f64, D>>) -> Self {
         const { assert!(D >= 1 && D <= 3, "the cell grid supports 1 to 3 dimensions") };
         let mut counts = [1usize; D];
+        let mut inverse = SVector::zeros();
         let mut widths = SVector::zeros();
         for a in 0..D {
-            let n = (sim_box.lengths[a] / (reach * (1.0 + WIDTH_SLACK))).floor().max(1.0);
+            let n = (sim_box.lengths[a] / (width * (1.0 + WIDTH_SLACK))).floor().max(1.0);
             counts[a] = n as usize;
+            inverse[a] = n / sim_box.lengths[a];
             widths[a] = sim_box.lengths[a] / n;
         }
         let total = counts.iter().product();
@@ -112,102 +128,91 @@ impl<const D: usize> Cells<D> {
             counts,
             strides,
             widths,
+            inverse,
             boundary: sim_box.boundary,
             head: vec![NONE; total],
             next: Vec::new(),
             coords: Vec::new(),
             wrapped: Vec::new(),
         };
-        for (i, r) in positions.enumerate() {
-            let mut m = [0i64; D];
-            for a in 0..D {
-                let raw = (r[a] / widths[a]).floor() as i64;
-                m[a] = match cells.boundary[a] {
-                    Boundary::Periodic => raw,
-                    Boundary::Wall => raw.clamp(0, counts[a] as i64 - 1),
-                };
-            }
-            cells.coords.push(m);
-            cells.wrapped.push(cells.wrap_axes(&m));
+        for (i, c) in centres.enumerate() {
             cells.next.push(NONE);
-            cells.insert(i);
+            let m = cells.locate(&c);
+            cells.insert(i, &m);
         }
         // The sentinel link past the last particle (see `gather`).
         cells.next.push(NONE);
-        cells.coords.shrink_to_fit();
-        cells.wrapped.shrink_to_fit();
         cells.next.shrink_to_fit();
         cells
     }
 
-    /// Rebuilds a grid from stored unwrapped coordinates (checkpoints).
-    pub fn from_coords(sim_box: &SimBox<D>, reach: f64, coords: Vec<[i64; D]>) -> Self {
-        let mut cells = Cells::new(sim_box, reach, std::iter::empty());
-        cells.next = vec![NONE; coords.len() + 1];
-        cells.wrapped = coords.iter().map(|m| cells.wrap_axes(m)).collect();
-        cells.coords = coords;
-        for i in 0..cells.coords.len() {
-            cells.insert(i);
+    /// A grid following the particles at `positions` (unwrapped), with cells at least
+    /// `width·(1 + 10⁻⁹)` wide.
+    pub fn follow(sim_box: &SimBox<D>, width: f64, positions: impl Iterator<Item = SVector<f64, D>>) -> Self {
+        let cells = Cells::new(sim_box, width, std::iter::empty());
+        let coords = positions
+            .map(|r| {
+                std::array::from_fn(|a| {
+                    let raw = (r[a] / cells.widths[a]).floor() as i64;
+                    match cells.boundary[a] {
+                        Boundary::Periodic => raw,
+                        Boundary::Wall => raw.clamp(0, cells.counts[a] as i64 - 1),
+                    }
+                })
+            })
+            .collect();
+        cells.with_coords(coords)
+    }
+
+    /// A grid following particles with the given unwrapped coordinates (checkpoints).
+    pub fn from_coords(sim_box: &SimBox<D>, width: f64, coords: Vec<[i64; D]>) -> Self {
+        Cells::new(sim_box, width, std::iter::empty()).with_coords(coords)
+    }
+
+    fn with_coords(mut self, mut coords: Vec<[i64; D]>) -> Self {
+        coords.shrink_to_fit();
+        self.next = vec![NONE; coords.len() + 1];
+        self.wrapped = coords.iter().map(|m| self.wrap_axes(m)).collect();
+        self.coords = coords;
+        for i in 0..self.coords.len() {
+            let m = self.wrapped[i];
+            self.insert(i, &m);
         }
-        cells
+        self
     }
 
     /// Heap bytes held (capacities, not lengths).
     pub fn memory_bytes(&self) -> usize {
-        use std::mem::size_of;
         (self.head.capacity() + self.next.capacity()) * size_of::<u32>()
             + self.coords.capacity() * size_of::<[i64; D]>()
-            + self.wrapped.capacity() * size_of::<[u32; D]>()
+            + self.wrapped.capacity() * size_of::<Coord<D>>()
     }
 
-    /// Cells per axis.
-    pub fn counts(&self) -> [usize; D] {
-        self.counts
-    }
-
-    /// The unwrapped cell coordinate of particle `i`.
+    /// Following: the unwrapped cell coordinate of particle `i`.
     pub fn coord(&self, i: usize) -> [i64; D] {
         self.coords[i]
     }
 
-    /// All unwrapped coordinates (for checkpoints).
+    /// Following: all unwrapped coordinates (for checkpoints).
     pub fn coords(&self) -> &[[i64; D]] {
         &self.coords
     }
 
+    /// Following: particle `i`'s cell.
+    #[inline]
+    pub fn wrapped(&self, i: usize) -> Coord<D> {
+        self.wrapped[i]
+    }
+
     /// An unwrapped coordinate wrapped into the grid, axis by axis.
-    fn wrap_axes(&self, m: &[i64; D]) -> [u32; D] {
+    fn wrap_axes(&self, m: &[i64; D]) -> Coord<D> {
         std::array::from_fn(|a| m[a].rem_euclid(self.counts[a] as i64) as u32)
     }
 
-    /// The flat index of particle `i`'s cell.
-    fn flat(&self, i: usize) -> usize {
-        (0..D).map(|a| self.wrapped[i][a] as usize * self.strides[a]).sum()
-    }
-
-    fn insert(&mut self, i: usize) {
-        let c = self.flat(i);
-        self.next[i] = self.head[c];
-        self.head[c] = i as u32;
-    }
-
-    fn remove(&mut self, i: usize) {
-        let c = self.flat(i);
-        let after = self.next[i];
-        if self.head[c] == i as u32 {
-            self.head[c] = after;
-            return;
-        }
-        let mut k = self.head[c];
-        while self.next[k as usize] != i as u32 {
-            k = self.next[k as usize];
-        }
-        self.next[k as usize] = after;
-    }
-
-    /// Moves particle `i` one cell along `axis`, up or down.
+    /// Following: moves particle `i` one cell along `axis`, up or down.
     pub fn shift(&mut self, i: usize, axis: usize, up: bool) {
-        self.remove(i);
+        let from = self.wrapped[i];
+        self.remove(i, &from);
         self.coords[i][axis] += if up { 1 } else { -1 };
         let (n, w) = (self.counts[axis] as u32, self.wrapped[i][axis]);
         self.wrapped[i][axis] = match up {
@@ -216,14 +221,17 @@ impl<const D: usize> Cells<D> {
             false if w == 0 => n - 1,
             false => w - 1,
         };
-        self.insert(i);
+        let to = self.wrapped[i];
+        self.insert(i, &to);
     }
 
     /// The time from `t0` at which a particle at `x` (at `t0`) moving with `v` leaves cell
-    /// `m` — `(Δt, axis, up)` — or `None` if it never does (at rest, or only walls ahead).
+    /// `m` (unwrapped) — `(Δt, axis, up)` — or `None` if it never does (at rest, or only
+    /// walls ahead).
     ///
     /// Which axis is crossed first, and in which direction, is a coin toss for the branch
     /// predictor, so both are chosen by selects, not branches.
+    #[inline]
     pub fn next_crossing(&self, m: &[i64; D], x: &SVector<f64, D>, v: &SVector<f64, D>) -> Option<(f64, usize, bool)> {
         let (mut best_dt, mut best_axis, mut best_up) = (f64::INFINITY, usize::MAX, false);
         for a in 0..D {
@@ -247,12 +255,57 @@ impl<const D: usize> Cells<D> {
         (best_axis != usize::MAX).then_some((best_dt, best_axis, best_up))
     }
 
-    /// The distinct cells adjacent to (and including) particle `i`'s cell, each listed once
-    /// even when an axis has fewer than three cells; no allocation. The order is the flat
-    /// index order of a 3^D block: axis 0 fastest.
-    pub fn around(&self, i: usize) -> Around {
+    /// Cells per axis.
+    pub fn counts(&self) -> [usize; D] {
+        self.counts
+    }
+
+    /// The cell of a centre: `⌊x/w⌋` per axis, wrapped along periodic axes and clamped to
+    /// the grid between walls.
+    #[inline]
+    pub fn locate(&self, x: &SVector<f64, D>) -> Coord<D> {
+        std::array::from_fn(|a| {
+            let (raw, n) = ((x[a] * self.inverse[a]).floor() as i64, self.counts[a] as i64);
+            match self.boundary[a] {
+                Boundary::Periodic => raw.rem_euclid(n) as u32,
+                Boundary::Wall => raw.clamp(0, n - 1) as u32,
+            }
+        })
+    }
+
+    /// The flat index of cell `m`.
+    fn flat(&self, m: &Coord<D>) -> usize {
+        (0..D).map(|a| m[a] as usize * self.strides[a]).sum()
+    }
+
+    /// Puts particle `i` into cell `m`.
+    pub fn insert(&mut self, i: usize, m: &Coord<D>) {
+        let c = self.flat(m);
+        self.next[i] = self.head[c];
+        self.head[c] = i as u32;
+    }
+
+    /// Takes particle `i` out of cell `m` (where it must be).
+    pub fn remove(&mut self, i: usize, m: &Coord<D>) {
+        let c = self.flat(m);
+        let after = self.next[i];
+        if self.head[c] == i as u32 {
+            self.head[c] = after;
+            return;
+        }
+        let mut k = self.head[c];
+        while self.next[k as usize] != i as u32 {
+            k = self.next[k as usize];
+        }
+        self.next[k as usize] = after;
+    }
+
+    /// The distinct cells adjacent to (and including) cell `m`, each listed once even when
+    /// an axis has fewer than three cells; no allocation. The order is the flat index order
+    /// of a 3^D block: axis 0 fastest.
+    pub fn around(&self, m: &Coord<D>) -> Around {
         let mut around = Around { cells: [0; 27], len: 0 };
-        self.stencil(i).for_each::<D>(
+        self.stencil(m).for_each::<D>(
             #[inline(always)]
             |c| {
                 around.cells[around.len] = c as u32;
@@ -262,14 +315,13 @@ impl<const D: usize> Cells<D> {
         around
     }
 
-    /// Particle `i`'s [`Stencil`]. Away from the walls every axis with three cells or more
+    /// The [`Stencil`] of cell `m`. Away from the walls every axis with three cells or more
     /// gives m − 1, m, m + 1, wrapped by comparison (this and the unrolled loops replaced a
     /// general construction that cost about 350 instructions a call; callgrind, N = 10⁴,
     /// η = 0.65); next to a wall, or with fewer than three cells (which wrap onto each
     /// other), the distinct ones are listed one by one.
     #[inline(always)]
-    fn stencil(&self, i: usize) -> Stencil {
-        let w = self.wrapped[i];
+    fn stencil(&self, w: &Coord<D>) -> Stencil {
         let mut s = Stencil { offsets: [[0; 3]; 3], lens: [1; 3], full: true };
         for a in 0..D {
             let (n, x, stride) = (self.counts[a], w[a] as usize, self.strides[a]);
@@ -297,10 +349,11 @@ impl<const D: usize> Cells<D> {
         s
     }
 
-    /// Prefetches particle `i`'s cell coordinate.
+    /// Following: prefetches particle `i`'s cell coordinates.
     #[inline]
     pub fn prefetch_coord(&self, i: usize) {
         super::prefetch::prefetch(&self.coords[i]);
+        super::prefetch::prefetch(&self.wrapped[i]);
     }
 
     /// Prefetches the heads of the cells `around` (from [`Cells::around`]).
@@ -330,8 +383,8 @@ impl<const D: usize> Cells<D> {
         Members { next: &self.next, at: self.head[c as usize] }
     }
 
-    /// Writes the particles in the cells around particle `i`, except `i` and `skip`, into
-    /// `out` and returns how many — or `None` when they do not fit (`out.len()` or more).
+    /// Writes the particles in the cells around cell `m`, except `i` and `skip`, into `out`
+    /// and returns how many — or `None` when they do not fit (`out.len()` or more).
     ///
     /// The first two members of each cell are taken without branches: a cell one contact
     /// distance wide seldom holds more, and how many it holds is a coin toss for the branch
@@ -341,13 +394,13 @@ impl<const D: usize> Cells<D> {
     /// `out[min(len, last)]`, with no early exit: once `len` reaches `out.len()` the entries
     /// are no longer trusted and the answer is `None`, but until then no write is clamped.
     #[inline]
-    pub fn gather(&self, i: usize, skip: usize, out: &mut [u32]) -> Option<usize> {
+    pub fn gather(&self, m: &Coord<D>, i: usize, skip: usize, out: &mut [u32]) -> Option<usize> {
         let sentinel = self.next.len() - 1;
         let last = out.len().checked_sub(1)?;
         let mut len = 0;
         // The closure is inlined into each of the unrolled cells (a call per cell cost more
         // than the members it gathers).
-        self.stencil(i).for_each::<D>(
+        self.stencil(m).for_each::<D>(
             #[inline(always)]
             |c| {
                 let mut j = self.head[c];
@@ -369,9 +422,9 @@ impl<const D: usize> Cells<D> {
         (len < out.len()).then_some(len)
     }
 
-    /// Every particle in the cells around particle `i` (itself included).
-    pub fn neighbours(&self, i: usize) -> impl Iterator<Item = usize> + '_ {
-        let around = self.around(i);
+    /// Every particle in the cells around cell `m`.
+    pub fn neighbours(&self, m: Coord<D>) -> impl Iterator<Item = usize> + '_ {
+        let around = self.around(&m);
         (0..around.len).flat_map(move |k| self.members(around.cells[k]).map(|j| j as usize))
     }
 }
@@ -403,13 +456,13 @@ mod tests {
 
     /// The cells around `m` by the definition: every `m + o`, `o ∈ {−1, 0, 1}^D`, inside the
     /// walls, wrapped, each once.
-    fn around_by_definition<const D: usize>(cells: &Cells<D>, m: &[i64; D]) -> Vec<u32> {
+    fn around_by_definition<const D: usize>(cells: &Cells<D>, m: &Coord<D>) -> Vec<u32> {
         let mut out = Vec::new();
         for code in 0..3usize.pow(D as u32) {
             let mut flat = 0;
             let mut inside = true;
             for a in 0..D {
-                let y = m[a] + (code / 3usize.pow(a as u32) % 3) as i64 - 1;
+                let y = m[a] as i64 + (code / 3usize.pow(a as u32) % 3) as i64 - 1;
                 let n = cells.counts[a] as i64;
                 inside &= cells.boundary[a] == Boundary::Periodic || (0..n).contains(&y);
                 flat += y.rem_euclid(n) as usize * cells.strides[a];
@@ -422,44 +475,50 @@ mod tests {
         out
     }
 
-    /// Random walks of particles through grids of 1 to 5 cells per axis, periodic and
-    /// walled, in 2D and 3D: after every shift, each particle's cells around (`around`, the
-    /// stencil's fast and slow paths) are those of the definition, and `gather` returns
-    /// exactly the members of those cells but `i` and `skip`.
+    /// Random moves of particles through grids of 1 to 5 cells per axis, periodic and
+    /// walled, in 2D and 3D, with centres anywhere (periodic ones several boxes away): each
+    /// centre is located in the cell that holds it (wrapped), each particle's cells around
+    /// (`around`, the stencil's fast and slow paths) are those of the definition, and
+    /// `gather` returns exactly the members of those cells but `i` and `skip`.
     fn walk<const D: usize>(seed: u64) {
         let mut rng = Xoshiro256PlusPlus::seed_from_u64(seed);
-        let mut boxes = 0;
-        while boxes < 60 {
+        for _ in 0..60 {
             let counts: [usize; D] = std::array::from_fn(|_| rng.random_range(1..=5));
             let boundary: [Boundary; D] =
                 std::array::from_fn(|_| if rng.random_range(0..2) == 0 { Boundary::Periodic } else { Boundary::Wall });
             let lengths = SVector::<f64, D>::from_fn(|a, _| counts[a] as f64 + 0.5);
             let sim_box = SimBox { lengths, boundary };
+            let centre = |rng: &mut Xoshiro256PlusPlus| {
+                SVector::<f64, D>::from_fn(|a, _| match boundary[a] {
+                    Boundary::Periodic => rng.random_range(-3.0..4.0) * lengths[a],
+                    Boundary::Wall => rng.random_range(0.0..lengths[a]),
+                })
+            };
             let n = 12;
-            let positions: Vec<_> =
-                (0..n).map(|_| SVector::<f64, D>::from_fn(|a, _| rng.random_range(0.0..lengths[a]))).collect();
-            let mut cells = Cells::new(&sim_box, 1.0, positions.into_iter());
+            let mut centres: Vec<_> = (0..n).map(|_| centre(&mut rng)).collect();
+            let mut cells = Cells::new(&sim_box, 1.0, centres.iter().copied());
             assert_eq!(cells.counts, counts);
-            boxes += 1;
             for _ in 0..200 {
                 let i = rng.random_range(0..n);
-                let axis = rng.random_range(0..D);
-                let up = rng.random_range(0..2) == 0;
-                let m = cells.coords[i][axis];
-                let blocked =
-                    boundary[axis] == Boundary::Wall && if up { m + 1 >= counts[axis] as i64 } else { m <= 0 };
-                if !blocked {
-                    cells.shift(i, axis, up);
-                }
+                let to = centre(&mut rng);
+                cells.remove(i, &cells.locate(&centres[i]));
+                cells.insert(i, &cells.locate(&to));
+                centres[i] = to;
                 for k in 0..n {
-                    assert_eq!(cells.wrapped[k], cells.wrap_axes(&cells.coords[k]));
-                    let mut got = cells.around(k).as_slice().to_vec();
+                    let m = cells.locate(&centres[k]);
+                    for a in 0..D {
+                        let w = lengths[a] / counts[a] as f64;
+                        let x = centres[k][a].rem_euclid(lengths[a]);
+                        assert!(x >= m[a] as f64 * w * (1.0 - 1e-12) && x <= (m[a] + 1) as f64 * w * (1.0 + 1e-12));
+                    }
+                    assert!(cells.members(cells.flat(&m) as u32).any(|j| j as usize == k));
+                    let mut got = cells.around(&m).as_slice().to_vec();
                     got.sort_unstable();
-                    let expected = around_by_definition(&cells, &cells.coords[k]);
-                    assert_eq!(got, expected, "counts {counts:?}, {boundary:?}, coord {:?}", cells.coords[k]);
+                    let expected = around_by_definition(&cells, &m);
+                    assert_eq!(got, expected, "counts {counts:?}, {boundary:?}, cell {m:?}");
                     let skip = (k + 1) % n;
                     let mut out = [0u32; 64];
-                    let len = cells.gather(k, skip, &mut out).expect("room for 12");
+                    let len = cells.gather(&m, k, skip, &mut out).expect("room for 12");
                     let mut members: Vec<u32> = expected
                         .iter()
                         .flat_map(|&c| cells.members(c))
@@ -486,11 +545,12 @@ mod tests {
         let sim_box = SimBox { lengths: SVector::from([10.5, 10.5]), boundary: [Boundary::Periodic; 2] };
         let positions = (0..40).map(|k| SVector::from([5.2 + 0.01 * k as f64, 5.3]));
         let cells = Cells::new(&sim_box, 1.0, positions);
+        let m = cells.locate(&SVector::from([5.2, 5.3]));
         let mut out = [0u32; 40];
-        assert_eq!(cells.gather(0, 0, &mut out), Some(39));
+        assert_eq!(cells.gather(&m, 0, 0, &mut out), Some(39));
         let mut small = [0u32; 39];
-        assert_eq!(cells.gather(0, 0, &mut small), None);
+        assert_eq!(cells.gather(&m, 0, 0, &mut small), None);
         let mut tiny = [0u32; 38];
-        assert_eq!(cells.gather(0, 0, &mut tiny), None);
+        assert_eq!(cells.gather(&m, 0, 0, &mut tiny), None);
     }
 }

@@ -29,13 +29,8 @@ pub enum EventKind {
         /// Upper (at L) or lower (at 0) wall.
         upper: bool,
     },
-    /// Particle `i` leaves its cell along `axis`, `up` or down.
-    Cell {
-        /// The axis.
-        axis: usize,
-        /// Direction.
-        up: bool,
-    },
+    /// Particle `i` leaves its skin: its neighbour list is rebuilt.
+    Rebuild,
     /// A scheduled sampling instant (no particle).
     Sample,
 }
@@ -45,7 +40,7 @@ impl EventKind {
         match *self {
             EventKind::Pair { j, .. } => (0, j, false),
             EventKind::Wall { axis, upper } => (1, axis, upper),
-            EventKind::Cell { axis, up } => (2, axis, up),
+            EventKind::Rebuild => (2, 0, false),
             EventKind::Sample => (3, 0, false),
         }
     }
@@ -65,7 +60,7 @@ pub struct Event {
 }
 
 impl Event {
-    /// The total order of events: by time, then pair < wall < cell < sample, then by the
+    /// The total order of events: by time, then pair < wall < rebuild < sample, then by the
     /// particles and axes involved. No two distinct live events compare equal, so the
     /// sequence of events never depends on the order in which they were pushed.
     pub fn order(&self, other: &Event) -> Ordering {
@@ -464,16 +459,11 @@ pub enum PendingKind {
         /// Upper (at L) or lower (at 0) wall.
         upper: bool,
     },
-    /// The owner leaves its cell along `axis`, `up` or down.
-    Cell {
-        /// The axis.
-        axis: u8,
-        /// Direction.
-        up: bool,
-    },
+    /// The owner leaves its skin: its neighbour list is rebuilt.
+    Rebuild,
 }
 
-/// Rank of a sampling event among events at the same instant (after pairs, walls, cells).
+/// Rank of a sampling event among events at the same instant (after pairs, walls, rebuilds).
 pub const SAMPLE_RANK: u8 = 3;
 
 impl Pending {
@@ -481,14 +471,14 @@ impl Pending {
     pub const NOTHING: Pending = Pending { time: f64::INFINITY, kind: PendingKind::Nothing };
 
     /// The tie-break key of `owner`'s pending event, the same as [`Event::order`] after the
-    /// time: kind rank (pair < wall < cell < sample < nothing), lower particle, then partner
+    /// time: kind rank (pair < wall < rebuild < sample < nothing), lower particle, then partner
     /// or axis and direction.
     #[inline]
     pub fn key(&self, owner: u32) -> (u8, u32, u32, u8) {
         match self.kind {
             PendingKind::Pair { partner, .. } => (0, owner.min(partner), owner.max(partner), 0),
             PendingKind::Wall { axis, upper } => (1, owner, axis as u32, upper as u8),
-            PendingKind::Cell { axis, up } => (2, owner, axis as u32, up as u8),
+            PendingKind::Rebuild => (2, owner, 0, 0),
             PendingKind::Nothing => (SAMPLE_RANK + 1, owner, 0, 0),
         }
     }

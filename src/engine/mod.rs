@@ -5,7 +5,8 @@
 //! * [`geometry`]: [`Particle`], [`SimBox`], [`Boundary`], minimum image.
 //! * [`collision`]: the velocity update and the [`Impulse`] it reports.
 //! * [`events`]: event types, their total order, the pure predictions.
-//! * [`cells`]: the cell grid.
+//! * [`cells`]: the cell grid (of neighbour-list centres).
+//! * [`neighbours`]: neighbour lists with a skin.
 //! * [`queue`]: one pending event per particle, in a tournament tree.
 //! * `prefetch`: the cache hint of the lookahead (the crate's one `unsafe` block).
 //! * [`simulation`]: the event loop.
@@ -17,6 +18,7 @@ pub mod collision;
 pub mod events;
 pub mod geometry;
 pub mod init;
+pub mod neighbours;
 mod prefetch;
 pub mod queue;
 pub mod reference;
@@ -24,5 +26,6 @@ pub mod simulation;
 
 pub use collision::{Body, Impulse, Restitution, RestitutionError, resolve_pair};
 pub use geometry::{Boundary, Particle, SimBox};
+pub use neighbours::Neighbourhood;
 pub use reference::ReferenceSimulation;
 pub use simulation::{EventCounts, Outcome, OverlapAudit, SetupError, Simulation, SimulationState};

@@ -51,18 +51,18 @@ struct Slot {
 
 const NOTHING_TAG: u32 = u32::MAX;
 const WALL_TAG: u32 = u32::MAX - 1;
-const CELL_TAG: u32 = u32::MAX - 2;
+const REBUILD_TAG: u32 = u32::MAX - 2;
 
 impl Slot {
     #[inline(always)]
     fn pack(e: Pending) -> Slot {
         let (who, what) = match e.kind {
             PendingKind::Pair { partner, partner_events } => {
-                debug_assert!(partner < CELL_TAG);
+                debug_assert!(partner < REBUILD_TAG);
                 (partner, partner_events)
             }
             PendingKind::Wall { axis, upper } => (WALL_TAG, axis as u32 | (upper as u32) << 8),
-            PendingKind::Cell { axis, up } => (CELL_TAG, axis as u32 | (up as u32) << 8),
+            PendingKind::Rebuild => (REBUILD_TAG, 0),
             PendingKind::Nothing => (NOTHING_TAG, 0),
         };
         Slot { time: e.time, who, what }
@@ -74,7 +74,7 @@ impl Slot {
         let kind = match self.who {
             NOTHING_TAG => PendingKind::Nothing,
             WALL_TAG => PendingKind::Wall { axis, upper: flag },
-            CELL_TAG => PendingKind::Cell { axis, up: flag },
+            REBUILD_TAG => PendingKind::Rebuild,
             partner => PendingKind::Pair { partner, partner_events: self.what },
         };
         Pending { time: self.time, kind }
@@ -343,11 +343,10 @@ mod tests {
     #[test]
     fn slots_keep_every_event() {
         let largest = crate::engine::simulation::MAX_PARTICLES as u32 - 1;
-        let mut kinds = vec![PendingKind::Nothing];
+        let mut kinds = vec![PendingKind::Nothing, PendingKind::Rebuild];
         for axis in [0u8, 1, 2] {
             for flag in [false, true] {
                 kinds.push(PendingKind::Wall { axis, upper: flag });
-                kinds.push(PendingKind::Cell { axis, up: flag });
             }
         }
         for partner in [0, 1, largest] {

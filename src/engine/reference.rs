@@ -4,8 +4,9 @@
 //! [`Simulation`](super::Simulation) on small systems and require the same sequence of events,
 //! bit for bit.
 //!
-//! Between collisions the minimum image of a pair can change. The fast engine notices
-//! through cell crossings; the reference instead never looks further ahead than
+//! Between collisions the minimum image of a pair can change. The fast engine predicts a
+//! pair only while both are inside their skins, where their separation stays below `L/2`
+//! (the image cannot switch before they have rebuilt their lists); the reference instead never looks further ahead than
 //! `(L/2 − reach)/(2·v_max)` — less than the time any pair needs to switch image and then
 //! touch — and predicts again from there when nothing happens sooner.
 
@@ -106,7 +107,7 @@ impl<const D: usize> ReferenceSimulation<D> {
                 resolve_wall_event(&mut self.particles[e.i], axis, upper, t);
                 (t, e.i, e.i)
             }
-            EventKind::Cell { .. } | EventKind::Sample => unreachable!("the reference predicts only collisions"),
+            EventKind::Rebuild | EventKind::Sample => unreachable!("the reference predicts only collisions"),
         }
     }
 }

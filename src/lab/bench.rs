@@ -4,7 +4,7 @@
 //! runs a warm-up that is not timed (so the lattice has melted and the queue has reached its
 //! working size), then times a fixed number of pair collisions on one core. Memory is
 //! reported twice: the engine's own account of its heap (capacities of the particle array,
-//! the event queue and the cells) and the process's peak resident set size when each point
+//! the event queue, the neighbour lists and their grid) and the process's peak resident set size when each point
 //! runs in a process of its own (`collide bench` does that).
 
 use super::plot::{Chart, Series};
@@ -34,8 +34,11 @@ pub struct BenchPoint {
     pub events_per_second: f64,
     /// Timed events by kind (stale = discarded invalid events).
     pub events_by_kind: EventCounts,
-    /// The engine's heap (particles, queue, cells) per particle, bytes, at the end.
+    /// The engine's heap (particles, queue, neighbour lists and their grid) per particle, bytes, at the end.
     pub engine_bytes_per_particle: f64,
+    /// The fraction of particles crowded at the end (more neighbours in range than a list
+    /// holds: they search the cell grid instead).
+    pub crowded_fraction: f64,
     /// Peak resident set size of the process, bytes (when known).
     pub peak_rss_bytes: Option<u64>,
 }
@@ -79,6 +82,7 @@ pub fn measure(n: usize, eta: f64, warmup_per_particle: u64, timed: u64, seed: u
         events_per_second: events_by_kind.total() as f64 / seconds,
         events_by_kind,
         engine_bytes_per_particle: sim.memory_bytes() as f64 / n as f64,
+        crowded_fraction: sim.crowded() as f64 / n as f64,
         peak_rss_bytes: peak_rss_bytes(),
     })
 }
@@ -109,7 +113,7 @@ pub fn today() -> String {
 pub fn markdown(points: &[BenchPoint], command: &str, machine: &str) -> String {
     let mut md = format!(
         "# collide benchmark report\n\n{} · collide {} · {machine} · one core\n\nCommand: `{command}`\n\n\
-         | N | η | collisions/s | ns/collision | events/s | pair : wall : cell : stale per collision | engine bytes/particle | peak RSS bytes/particle |\n\
+         | N | η | collisions/s | ns/collision | events/s | pair : wall : rebuild : stale per collision | engine bytes/particle | peak RSS bytes/particle |\n\
          |---|---|---|---|---|---|---|---|\n",
         today(),
         env!("CARGO_PKG_VERSION")
@@ -125,7 +129,7 @@ pub fn markdown(points: &[BenchPoint], command: &str, machine: &str) -> String {
             p.ns_per_collision,
             p.events_per_second,
             per(e.wall),
-            per(e.cell),
+            per(e.rebuild),
             per(e.stale),
             p.engine_bytes_per_particle,
             p.peak_rss_bytes.map_or("—".into(), |b| format!("{:.0}", b as f64 / p.n_particles as f64)),

@@ -1,0 +1,488 @@
+//! Neighbour lists with a skin: who can touch whom before someone moves too far.
+//!
+//! Each particle `i` has a *centre* `cᵢ` — where it was when its list was last built — and a
+//! list of every particle `j` whose centre lies within the range `R = reach + s` of `cᵢ`
+//! (minimum image; `reach` the largest contact distance, `s` the skin). While both stay
+//! within `s/2` of their centres, `|rᵢ − rⱼ| ≥ |cᵢ − cⱼ| − s`, so two particles not in each
+//! other's lists cannot touch. A particle leaving its skin (`|rᵢ − cᵢ|` reaching
+//! `h = (s/2)(1 − 2⁻²⁰)`, a margin far above the rounding of positions and times) is an
+//! event: its centre moves to where it is and its list is rebuilt
+//! ([`Neighbours::rebuild`]).
+//!
+//! The relation "within range" is symmetric, and so are the lists: when `i` rebuilds, it
+//! leaves the lists of its old neighbours and joins those of its new ones. The simulation
+//! relies on this — a particle that changes course predicts only against its own list, so
+//! every particle that can reach it must be on it. The separation of two centres is
+//! computed as the exact negative from either side (`cⱼ − cᵢ = −(cᵢ − cⱼ)` in floating
+//! point, and the minimum image count is `−round(d/L)`, odd in `d`), so both sides agree.
+//!
+//! A list holds at most [`CAPACITY`] neighbours in one 32-byte block (a contiguous row, read
+//! by the batch kernel eight lanes at a time). A particle with more is *crowded*: it keeps
+//! no list and searches the cell grid around its centre instead, which holds everyone in
+//! range (cells are `R` wide); it gets a list again at its next rebuild if the neighbours
+//! then fit. With short periodic axes (several images of one pair in range) no lists are
+//! kept at all and every search goes through the grid.
+//!
+//! The cell grid ([`Cells`]) holds each particle by its centre, so a particle changes cell
+//! only when it rebuilds — the cell-crossing events of a grid that follows the particles
+//! are gone.
+
+use super::cells::{Cells, Coord};
+use super::geometry::{Boundary, Particle, SimBox};
+use super::prefetch::prefetch;
+use nalgebra::SVector;
+use serde::{Deserialize, Serialize};
+
+/// The most neighbours a list holds (a crowded particle searches the grid).
+pub const CAPACITY: usize = 8;
+
+/// An unused entry (lists are packed at the front).
+const NONE: u32 = u32::MAX;
+
+/// The first entry of a crowded particle's list.
+const CROWDED: u32 = u32::MAX - 1;
+
+/// One particle's neighbours, `NONE` after the last; `[CROWDED, ..]` for a crowded particle.
+#[derive(Clone, Copy, Debug)]
+#[repr(C, align(32))]
+struct List([u32; CAPACITY]);
+
+impl List {
+    const EMPTY: List = List([NONE; CAPACITY]);
+    const CROWDED: List = {
+        let mut list = List::EMPTY;
+        list.0[0] = CROWDED;
+        list
+    };
+
+    fn crowded(&self) -> bool {
+        self.0[0] == CROWDED
+    }
+
+    /// Takes `i` out, moving the last entry into its place (no-op if crowded or absent).
+    fn drop(&mut self, i: u32) {
+        if self.crowded() {
+            return;
+        }
+        let len = self.0.iter().position(|&j| j == NONE).unwrap_or(CAPACITY);
+        if let Some(k) = self.0[..len].iter().position(|&j| j == i) {
+            self.0[k] = self.0[len - 1];
+            self.0[len - 1] = NONE;
+        }
+    }
+
+    /// Puts `i` in; a full list becomes crowded.
+    fn add(&mut self, i: u32) {
+        if self.crowded() {
+            return;
+        }
+        match self.0.iter().position(|&j| j == NONE) {
+            Some(k) => self.0[k] = i,
+            None => *self = List::CROWDED,
+        }
+    }
+
+    fn from_members(members: &[u32]) -> List {
+        if members.len() > CAPACITY {
+            return List::CROWDED;
+        }
+        let mut list = List::EMPTY;
+        list.0[..members.len()].copy_from_slice(members);
+        list
+    }
+}
+
+/// Lists are kept (by [`Neighbourhood::Auto`]) from this packing fraction on,
+/// `n·π(reach/2)²` with `n` the number density, and from [`LISTS_FROM_N`] particles.
+/// Measured at η = 0.65 (alternating runs, medians of 3, 10⁶ collisions/s, lists against
+/// the grid): 1.51 vs 1.56 at N = 10⁴, 1.10 vs 1.19 at 3·10⁴, 1.02 vs 0.93 at 10⁵, 0.88 vs
+/// 0.64 at 10⁶; at η = 0.6 and N = 10⁵ 0.83 vs 0.85; at η = 0.5, 0.62 vs 0.81 at 10⁵ and
+/// 0.50 vs 0.59 at 10⁶. Lists save the walk through the cell lists and most of the cache
+/// misses around a collision, which pays only once the state is far out of cache; at lower
+/// densities a particle leaves its skin so often that the rebuilds cost more.
+pub const LISTS_FROM: f64 = 0.62;
+
+/// The fewest particles for which [`Neighbourhood::Auto`] keeps lists (3·2¹⁴, where the
+/// engine's state outgrows the caches; see [`LISTS_FROM`]).
+pub const LISTS_FROM_N: usize = 3 << 14;
+
+/// The mean number of particles the list range is sized to hold, `n·πR²`. Measured at
+/// η = 0.65, N = 10⁴ (skin as a fraction of the contact distance: collisions/s, rebuilds
+/// per collision, crowded particles): 0.25: 0.93·10⁶, 0.76, 0 %; 0.6: 1.48·10⁶, 0.20, 0 %;
+/// 0.8 (which this gives): 1.59·10⁶, 0.12, 5 %; 1.0 at N = 10⁵: 41 % crowded and 25 %
+/// slower than 0.8.
+pub const RANGE_HOLDS: f64 = 8.4;
+
+/// How [`Simulation`](super::Simulation) finds the particles that can touch one another.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Neighbourhood {
+    /// Lists where they pay ([`LISTS_FROM`], [`LISTS_FROM_N`]), the grid elsewhere.
+    #[default]
+    Auto,
+    /// A grid of cells one contact distance wide following the particles (an event at each
+    /// cell boundary).
+    Grid,
+    /// Neighbour lists with a skin, where they can be kept (2D, no short periodic axis);
+    /// elsewhere the grid.
+    Lists,
+}
+
+/// The skin for lists, or `None` for the grid that follows the particles: lists only in 2D
+/// (in 3D a list of [`CAPACITY`] holds fewer than a dense fluid's neighbours), with no short
+/// periodic axis (`allow`), and for [`Neighbourhood::Auto`] from [`LISTS_FROM`] and
+/// [`LISTS_FROM_N`] on. The skin makes the range hold [`RANGE_HOLDS`] particles, within
+/// `[reach/4, reach]`, and short enough that a range plus a skin stays under half of every
+/// periodic box length (one image of a pair in range).
+fn skin_for<const D: usize>(
+    sim_box: &SimBox<D>,
+    reach: f64,
+    n: usize,
+    allow: bool,
+    choice: Neighbourhood,
+) -> Option<f64> {
+    let density = n as f64 / sim_box.volume();
+    let eta = density * std::f64::consts::PI * 0.25 * reach * reach;
+    let wanted = match choice {
+        Neighbourhood::Auto => eta >= LISTS_FROM && n >= LISTS_FROM_N,
+        Neighbourhood::Grid => false,
+        Neighbourhood::Lists => true,
+    };
+    if D != 2 || !allow || !wanted {
+        return None;
+    }
+    let range = (RANGE_HOLDS / (std::f64::consts::PI * density)).sqrt();
+    let mut skin = (range - reach).clamp(0.25 * reach, reach);
+    for a in 0..D {
+        if sim_box.boundary[a] == Boundary::Periodic {
+            skin = skin.min(0.45 * (0.5 * sim_box.lengths[a] - reach));
+        }
+    }
+    Some(skin)
+}
+
+/// The centres, the lists and the grid of centres — or the grid that follows the particles.
+#[derive(Clone, Debug)]
+pub struct Neighbours<const D: usize> {
+    cells: Cells<D>,
+    /// Whether lists are kept (else the grid follows the particles).
+    listed: bool,
+    /// Lists: one per particle (else empty).
+    centres: Vec<SVector<f64, D>>,
+    /// Lists: one per particle (else empty).
+    lists: Vec<List>,
+    /// `R²`, the list range squared.
+    range2: f64,
+    /// `h²`, the skin's exit radius squared.
+    exit2: f64,
+    /// `(s/2)²`: how far from its centre a particle may be.
+    bound2: f64,
+    sim_box: SimBox<D>,
+    /// A rebuild's new neighbours (kept, so that no rebuild allocates once warmed up).
+    scratch: Vec<u32>,
+}
+
+/// How a saved [`Neighbours`] is restored: the grid's unwrapped cell coordinates, or the
+/// list centres.
+#[derive(Clone, Debug)]
+pub enum Saved<const D: usize> {
+    /// Following: one unwrapped cell coordinate per particle.
+    Cells(Vec<[i64; D]>),
+    /// Lists: one centre per particle.
+    Centres(Vec<SVector<f64, D>>),
+}
+
+impl<const D: usize> Neighbours<D> {
+    /// Lists (centred where the particles are at `time`) or a grid following the particles,
+    /// as [`skin_for`] decides; `allow_lists` is false with short periodic axes.
+    pub fn new(
+        sim_box: &SimBox<D>,
+        reach: f64,
+        particles: &[Particle<D>],
+        time: f64,
+        allow_lists: bool,
+        choice: Neighbourhood,
+    ) -> Self {
+        match skin_for(sim_box, reach, particles.len(), allow_lists, choice) {
+            Some(_) => {
+                let centres = particles.iter().map(|p| p.position_at(time)).collect();
+                Self::restore(sim_box, reach, particles.len(), allow_lists, choice, Saved::Centres(centres))
+                    .expect("one centre per particle")
+            }
+            None => Self::following(sim_box, reach, particles),
+        }
+    }
+
+    /// A grid of cells `reach` wide following the particles, no lists.
+    pub fn following(sim_box: &SimBox<D>, reach: f64, particles: &[Particle<D>]) -> Self {
+        Self::bare(sim_box, Cells::follow(sim_box, reach, particles.iter().map(|p| p.position_at(p.time))))
+    }
+
+    /// The grid alone, no lists.
+    fn bare(sim_box: &SimBox<D>, cells: Cells<D>) -> Self {
+        Neighbours {
+            cells,
+            listed: false,
+            centres: Vec::new(),
+            lists: Vec::new(),
+            range2: 0.0,
+            exit2: 0.0,
+            bound2: 0.0,
+            sim_box: *sim_box,
+            scratch: Vec::new(),
+        }
+    }
+
+    /// Rebuilds from a saved state; `Err` says what does not fit (the wrong kind for this
+    /// box and density, or the wrong count).
+    pub fn restore(
+        sim_box: &SimBox<D>,
+        reach: f64,
+        n: usize,
+        allow_lists: bool,
+        choice: Neighbourhood,
+        saved: Saved<D>,
+    ) -> Result<Self, String> {
+        let skin = skin_for(sim_box, reach, n, allow_lists, choice);
+        let empty = |cells| Self::bare(sim_box, cells);
+        match (skin, saved) {
+            (None, Saved::Cells(coords)) if coords.len() == n => Ok(empty(Cells::from_coords(sim_box, reach, coords))),
+            (Some(skin), Saved::Centres(mut centres)) if centres.len() == n => {
+                let range = reach + skin;
+                let half = 0.5 * skin * (1.0 - f64::EPSILON * (1u64 << 32) as f64);
+                centres.shrink_to_fit();
+                let mut neighbours = empty(Cells::new(sim_box, range, centres.iter().copied()));
+                neighbours.centres = centres;
+                neighbours.listed = true;
+                neighbours.range2 = range * range;
+                neighbours.exit2 = half * half;
+                neighbours.bound2 = 0.25 * skin * skin;
+                neighbours.lists = (0..n)
+                    .map(|i| {
+                        neighbours.scan(i);
+                        List::from_members(&neighbours.scratch)
+                    })
+                    .collect();
+                Ok(neighbours)
+            }
+            (skin, _) => Err(format!(
+                "{n} {} expected",
+                if skin.is_some() { "neighbour-list centres" } else { "cell coordinates" }
+            )),
+        }
+    }
+
+    /// What [`restore`](Self::restore) takes back.
+    pub fn save(&self) -> Saved<D> {
+        match self.listed() {
+            true => Saved::Centres(self.centres.clone()),
+            false => Saved::Cells(self.cells.coords().to_vec()),
+        }
+    }
+
+    /// Heap bytes held (capacities).
+    pub fn memory_bytes(&self) -> usize {
+        self.cells.memory_bytes()
+            + self.centres.capacity() * size_of::<SVector<f64, D>>()
+            + self.lists.capacity() * size_of::<List>()
+            + self.scratch.capacity() * size_of::<u32>()
+    }
+
+    /// Cells per axis of the grid of centres.
+    pub fn cell_counts(&self) -> [usize; D] {
+        self.cells.counts()
+    }
+
+    /// Whether lists are kept (else every search goes through the grid).
+    pub fn listed(&self) -> bool {
+        self.listed
+    }
+
+    /// Particle `i`'s cell.
+    #[inline]
+    fn cell(&self, i: usize) -> Coord<D> {
+        if self.listed() { self.cells.locate(&self.centres[i]) } else { self.cells.wrapped(i) }
+    }
+
+    /// Whether the centres of `i` and `j` are within range (minimum image).
+    #[inline]
+    fn within(&self, i: usize, j: usize) -> bool {
+        let d = self.centres[j] - self.centres[i];
+        (d + self.sim_box.minimum_image_shift(&d)).norm_squared() < self.range2
+    }
+
+    /// Lists in `scratch` everyone within range of `i`'s centre.
+    fn scan(&mut self, i: usize) {
+        let mut found = std::mem::take(&mut self.scratch);
+        found.clear();
+        found.extend(self.cells.neighbours(self.cell(i)).filter(|&j| j != i && self.within(i, j)).map(|j| j as u32));
+        self.scratch = found;
+    }
+
+    /// Particle `p` (number `i`) has reached the time `t` of its
+    /// [`exit_time`](Self::exit_time). With lists, its centre moves to where it is, and it
+    /// leaves the lists of the particles no longer in range and joins those newly in range.
+    /// Following, it moves to the next cell (the crossing found again: the same pure function
+    /// of the same state).
+    pub fn rebuild(&mut self, i: usize, p: &Particle<D>, t: f64) {
+        let listed = self.listed();
+        if !listed {
+            let (_, axis, up) =
+                self.cells.next_crossing(&self.cells.coord(i), &p.position, &p.velocity).expect("a crossing");
+            self.cells.shift(i, axis, up);
+            return;
+        }
+        let centre = p.position_at(t);
+        {
+            // Leave every old neighbour's list (a crowded particle does not know them:
+            // everyone in the cells around is asked, and `drop` ignores those without it).
+            let list = self.lists[i];
+            if list.crowded() {
+                for j in self.cells.neighbours(self.cell(i)) {
+                    if j != i {
+                        self.lists[j].drop(i as u32);
+                    }
+                }
+            } else {
+                for &j in list.0.iter().take_while(|&&j| j != NONE) {
+                    self.lists[j as usize].drop(i as u32);
+                }
+            }
+        }
+        let (from, to) = (self.cell(i), self.cells.locate(&centre));
+        if from != to {
+            self.cells.remove(i, &from);
+            self.cells.insert(i, &to);
+        }
+        self.centres[i] = centre;
+        {
+            self.scan(i);
+            for &j in &self.scratch {
+                self.lists[j as usize].add(i as u32);
+            }
+            self.lists[i] = List::from_members(&self.scratch);
+        }
+    }
+
+    /// When particle `p` (number `i`) next has to [`rebuild`](Self::rebuild), as an absolute
+    /// time no earlier than `now`: following, when it leaves its cell; with lists, when it
+    /// reaches the skin's exit radius (it is inside at `now`): `now + τ`, `τ` the larger root
+    /// of `|d + vτ|² = h²`, `d = r(now) − cᵢ`, taken in the form without cancellation.
+    /// Velocities are scaled by their largest component first, so that neither `|v|²` nor
+    /// `d·v` overflows or underflows. `None` at rest, or never.
+    #[inline]
+    pub fn exit_time(&self, i: usize, p: &Particle<D>, now: f64) -> Option<f64> {
+        if !self.listed() {
+            let m = self.cells.coord(i);
+            return self.cells.next_crossing(&m, &p.position, &p.velocity).map(|(dt, ..)| (p.time + dt).max(now));
+        }
+        let c = &self.centres[i];
+        let scale = p.velocity.iter().fold(0.0f64, |m, v| m.max(v.abs()));
+        if scale == 0.0 {
+            return None;
+        }
+        let inverse = 1.0 / scale;
+        let (mut a, mut b, mut dd) = (0.0, 0.0, 0.0);
+        for k in 0..D {
+            let d = (p.position[k] + p.velocity[k] * (now - p.time)) - c[k];
+            let u = p.velocity[k] * inverse;
+            a += u * u;
+            b += d * u;
+            dd += d * d;
+        }
+        // Inside (up to rounding, at the instant of leaving): the constant term is ≤ 0.
+        let c0 = (dd - self.exit2).min(0.0);
+        let root = (b * b - a * c0).sqrt();
+        let tau = if b <= 0.0 { (root - b) / a } else { -c0 / (b + root) } / scale;
+        let t = now + tau.max(0.0);
+        t.is_finite().then_some(t)
+    }
+
+    /// Whether particle `p` (number `i`) is within half a skin of its centre at `t` (a saved
+    /// state must be).
+    pub fn inside(&self, i: usize, p: &Particle<D>, t: f64) -> bool {
+        !self.listed() || (p.position_at(t) - self.centres[i]).norm_squared() <= self.bound2
+    }
+
+    /// Writes particle `i`'s neighbours but `skip` into `out` and returns how many: its
+    /// list, copied without branches — or, if it is crowded, the members of the cells around
+    /// its centre (`None` if they do not fit).
+    #[inline]
+    pub fn gather(&self, i: usize, skip: usize, out: &mut [u32]) -> Option<usize> {
+        let Some(list) = self.lists.get(i).filter(|list| !list.crowded()) else {
+            return self.cells.gather(&self.cell(i), i, skip, out);
+        };
+        let mut len = 0;
+        for (k, &j) in list.0.iter().enumerate() {
+            out[len.min(k)] = j;
+            len += ((j != NONE) & (j as usize != skip)) as usize;
+        }
+        Some(len)
+    }
+
+    /// The particles that can touch `i` before it next rebuilds — its list, or (crowded, or
+    /// without lists) everyone in the cells around it, `i` included — the same set the
+    /// batch search sees through [`gather`](Self::gather).
+    pub fn candidates(&self, i: usize) -> impl Iterator<Item = usize> + '_ {
+        let list = self.lists.get(i).filter(|list| !list.crowded());
+        let listed = list.into_iter().flat_map(|list| list.0.iter().take_while(|&&j| j != NONE).map(|&j| j as usize));
+        let grid = list.is_none().then(|| self.cells.neighbours(self.cell(i))).into_iter().flatten();
+        listed.chain(grid)
+    }
+
+    /// The lookahead's first stage for particle `i`: its list and centre, or its cell
+    /// coordinates.
+    #[inline]
+    pub fn prefetch_first(&self, i: usize) {
+        if self.listed {
+            prefetch(&self.lists[i]);
+            prefetch(&self.centres[i]);
+        } else {
+            self.cells.prefetch_coord(i);
+        }
+    }
+
+    /// The second stage (the first should have arrived): the records (from `records`, one
+    /// per particle) on `i`'s list, or the heads of the cells around it.
+    #[inline]
+    pub fn prefetch_second<T>(&self, i: usize, records: &[T]) {
+        if !self.listed {
+            self.cells.prefetch_heads(&self.cells.around(&self.cells.wrapped(i)));
+        } else if !self.lists[i].crowded() {
+            for &j in self.lists[i].0.iter().take_while(|&&j| j != NONE) {
+                prefetch(&records[j as usize]);
+            }
+        }
+    }
+
+    /// The third stage, for the grid (the heads should have arrived): the first member of
+    /// each cell around `i`, and its link.
+    #[inline]
+    pub fn prefetch_third<T>(&self, i: usize, records: &[T]) {
+        if !self.listed {
+            self.cells.prefetch_members(&self.cells.around(&self.cells.wrapped(i)), records);
+        }
+    }
+
+    /// Checks the lists against their definition: `j` is on `i`'s list exactly when their
+    /// centres are within range (for the particles that are not crowded); for tests.
+    #[cfg(test)]
+    pub fn check(&self) {
+        for i in 0..self.lists.len() {
+            if self.lists[i].crowded() {
+                continue;
+            }
+            let mut listed: Vec<u32> = self.lists[i].0.iter().copied().take_while(|&j| j != NONE).collect();
+            listed.sort_unstable();
+            let mut expected: Vec<u32> =
+                (0..self.centres.len()).filter(|&j| j != i && self.within(i, j)).map(|j| j as u32).collect();
+            expected.sort_unstable();
+            assert_eq!(listed, expected, "particle {i}");
+        }
+    }
+
+    /// How many particles are crowded (for tests and the benchmark's notes).
+    pub fn crowded(&self) -> usize {
+        self.lists.iter().filter(|list| list.crowded()).count()
+    }
+}
