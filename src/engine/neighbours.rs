@@ -325,43 +325,38 @@ impl<const D: usize> Neighbours<D> {
     /// Following, it moves to the next cell (the crossing found again: the same pure function
     /// of the same state).
     pub fn rebuild(&mut self, i: usize, p: &Particle<D>, t: f64) {
-        let listed = self.listed();
-        if !listed {
+        if !self.listed {
             let (_, axis, up) =
                 self.cells.next_crossing(&self.cells.coord(i), &p.position, &p.velocity).expect("a crossing");
             self.cells.shift(i, axis, up);
             return;
         }
-        let centre = p.position_at(t);
-        {
-            // Leave every old neighbour's list (a crowded particle does not know them:
-            // everyone in the cells around is asked, and `drop` ignores those without it).
-            let list = self.lists[i];
-            if list.crowded() {
-                for j in self.cells.neighbours(self.cell(i)) {
-                    if j != i {
-                        self.lists[j].drop(i as u32);
-                    }
-                }
-            } else {
-                for &j in list.0.iter().take_while(|&&j| j != NONE) {
-                    self.lists[j as usize].drop(i as u32);
+        // Leave every old neighbour's list (a crowded particle does not know them: everyone
+        // in the cells around is asked, and `drop` ignores those without it).
+        let list = self.lists[i];
+        if list.crowded() {
+            for j in self.cells.neighbours(self.cell(i)) {
+                if j != i {
+                    self.lists[j].drop(i as u32);
                 }
             }
+        } else {
+            for &j in list.0.iter().take_while(|&&j| j != NONE) {
+                self.lists[j as usize].drop(i as u32);
+            }
         }
+        let centre = p.position_at(t);
         let (from, to) = (self.cell(i), self.cells.locate(&centre));
         if from != to {
             self.cells.remove(i, &from);
             self.cells.insert(i, &to);
         }
         self.centres[i] = centre;
-        {
-            self.scan(i);
-            for &j in &self.scratch {
-                self.lists[j as usize].add(i as u32);
-            }
-            self.lists[i] = List::from_members(&self.scratch);
+        self.scan(i);
+        for &j in &self.scratch {
+            self.lists[j as usize].add(i as u32);
         }
+        self.lists[i] = List::from_members(&self.scratch);
     }
 
     /// When particle `p` (number `i`) next has to [`rebuild`](Self::rebuild), as an absolute
