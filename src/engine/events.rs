@@ -29,7 +29,7 @@ pub enum EventKind {
         /// Upper (at L) or lower (at 0) wall.
         upper: bool,
     },
-    /// Particle `i` leaves its skin: its neighbour list is rebuilt.
+    /// Particle `i`'s neighbourhood is updated (it leaves its skin, or its cell).
     Rebuild,
     /// A scheduled sampling instant (no particle).
     Sample,
@@ -459,7 +459,8 @@ pub enum PendingKind {
         /// Upper (at L) or lower (at 0) wall.
         upper: bool,
     },
-    /// The owner leaves its skin: its neighbour list is rebuilt.
+    /// The owner's neighbourhood is updated: it leaves its skin (its list is rebuilt) or,
+    /// with the grid, its cell.
     Rebuild,
 }
 

@@ -1,4 +1,8 @@
-//! Neighbour lists with a skin: who can touch whom before someone moves too far.
+//! Who can touch whom: neighbour lists with a skin for dense, large systems, or a cell grid
+//! that follows the particles everywhere else ([`Neighbourhood`] chooses; the collisions are
+//! the same either way). With the grid, a particle's neighbours are the members of the cells
+//! around its own, and crossing into the next cell is the event that keeps that true. The
+//! rest of this overview is about the lists.
 //!
 //! Each particle `i` has a *centre* `cᵢ` — where it was when its list was last built — and a
 //! list of every particle `j` whose centre lies within the range `R = reach + s` of `cᵢ`
@@ -20,12 +24,12 @@
 //! by the batch kernel eight lanes at a time). A particle with more is *crowded*: it keeps
 //! no list and searches the cell grid around its centre instead, which holds everyone in
 //! range (cells are `R` wide); it gets a list again at its next rebuild if the neighbours
-//! then fit. With short periodic axes (several images of one pair in range) no lists are
-//! kept at all and every search goes through the grid.
+//! then fit. With short periodic axes (several images of one pair in range), in 3D, and for
+//! [`Neighbourhood::Auto`] below [`LISTS_FROM`] or [`LISTS_FROM_N`], no lists are kept and
+//! the grid follows the particles.
 //!
-//! The cell grid ([`Cells`]) holds each particle by its centre, so a particle changes cell
-//! only when it rebuilds — the cell-crossing events of a grid that follows the particles
-//! are gone.
+//! With lists, the cell grid ([`Cells`]) holds each particle by its centre, so a particle
+//! changes cell only when it rebuilds, with no crossing events.
 
 use super::cells::{Cells, Coord};
 use super::geometry::{Boundary, Particle, SimBox};

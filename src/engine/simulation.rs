@@ -53,7 +53,8 @@ pub enum Outcome<const D: usize> {
         /// |Δp| = 2m|v⊥|.
         impulse: f64,
     },
-    /// A particle left its skin and its neighbour list was rebuilt (bookkeeping only).
+    /// A particle's neighbourhood was updated: it left its skin and its list was rebuilt,
+    /// or (with the grid) it crossed into the next cell. Bookkeeping only.
     Rebuild,
     /// A scheduled sampling time was reached.
     Sample,
@@ -66,7 +67,8 @@ pub struct EventCounts {
     pub pair: u64,
     /// Wall collisions.
     pub wall: u64,
-    /// Neighbour-list rebuilds (a particle leaving its skin).
+    /// Neighbourhood updates: list rebuilds (a particle leaving its skin) or, with the grid,
+    /// cell crossings.
     pub rebuild: u64,
     /// Sampling events.
     pub sample: u64,
@@ -390,16 +392,14 @@ impl<const D: usize> Simulation<D> {
 
     /// The complete state, for checkpoints.
     pub fn state(&self) -> SimulationState<D> {
+        let (cells, centres) = match self.neighbours.save() {
+            Saved::Cells(coords) => (coords.iter().map(|m| m.to_vec()).collect(), Vec::new()),
+            Saved::Centres(centres) => (Vec::new(), centres.iter().map(|c| c.as_slice().to_vec()).collect()),
+        };
         SimulationState {
             particles: self.particles.clone(),
-            cells: match self.neighbours.save() {
-                Saved::Cells(coords) => coords.iter().map(|m| m.to_vec()).collect(),
-                Saved::Centres(_) => Vec::new(),
-            },
-            centres: match self.neighbours.save() {
-                Saved::Centres(centres) => centres.iter().map(|c| c.as_slice().to_vec()).collect(),
-                Saved::Cells(_) => Vec::new(),
-            },
+            cells,
+            centres,
             neighbourhood: self.neighbourhood,
             pending: self.queue.pending(),
             time: self.time,
@@ -561,7 +561,7 @@ impl<const D: usize> Simulation<D> {
         let ahead = next.map(|next| self.prefetch_neighbourhood(next));
         self.predict_among(i, i, &near, gathered);
         if let Some(ahead) = &ahead {
-            self.prefetch_members(ahead);
+            self.prefetch_last_stage(ahead);
         }
     }
 
@@ -591,7 +591,7 @@ impl<const D: usize> Simulation<D> {
         let ahead = next.map(|next| self.prefetch_neighbourhood(next));
         self.predict_among(i, j, &near_i, gathered_i);
         if let Some(ahead) = &ahead {
-            self.prefetch_members(ahead);
+            self.prefetch_last_stage(ahead);
         }
         self.predict_among(j, j, &near_j, gathered_j);
     }
@@ -624,7 +624,7 @@ impl<const D: usize> Simulation<D> {
     }
 
     /// The third stage.
-    fn prefetch_members(&self, ahead: &Ahead) {
+    fn prefetch_last_stage(&self, ahead: &Ahead) {
         self.neighbours.prefetch_third(ahead.next, &self.particles);
         if let Some(partner) = ahead.partner {
             self.neighbours.prefetch_second(partner, &self.particles);
