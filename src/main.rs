@@ -3,6 +3,7 @@
 
 use anyhow::{Context, Result, bail};
 use clap::{Args, Parser, Subcommand};
+use collide::engine::Neighbourhood;
 use collide::io::numbers::{NumberFormat, format_text, parse_text};
 use collide::io::query::{DynBall, Query, answer_lines, contact_time_dyn};
 use collide::quadratic::Roots;
@@ -50,6 +51,8 @@ enum Command {
         timed: u64,
         #[arg(long, default_value_t = 1)]
         seed: u64,
+        #[arg(long, default_value_t = Neighbourhood::Auto)]
+        neighbourhood: Neighbourhood,
     },
     /// Checks the numerics on this machine against the built-in edge-case reference;
     /// exits non-zero on any mismatch.
@@ -87,6 +90,10 @@ struct BenchArgs {
     /// Output directory.
     #[arg(long, default_value = "bench")]
     out: PathBuf,
+    /// How particles find their neighbours: `auto` (lists for dense systems of 3·2¹⁴
+    /// disks or more, the grid elsewhere), `grid` or `lists`.
+    #[arg(long, default_value_t = Neighbourhood::Auto)]
+    neighbourhood: Neighbourhood,
 }
 
 #[derive(Args)]
@@ -169,8 +176,9 @@ fn run(cli: Cli) -> Result<ExitCode> {
         Command::Validate(args) => validate(args),
         Command::Check => check(),
         Command::Bench(args) => bench(args),
-        Command::BenchPoint { n, eta, warmup, timed, seed } => {
-            let point = collide::lab::bench::measure(n, eta, warmup, timed, seed).map_err(anyhow::Error::msg)?;
+        Command::BenchPoint { n, eta, warmup, timed, seed, neighbourhood } => {
+            let point =
+                collide::lab::bench::measure(n, eta, neighbourhood, warmup, timed, seed).map_err(anyhow::Error::msg)?;
             say!("{}", serde_json::to_string(&point)?);
             Ok(ExitCode::SUCCESS)
         }
@@ -356,6 +364,7 @@ fn bench(args: BenchArgs) -> Result<ExitCode> {
         let output = std::process::Command::new(&exe)
             .args(["bench-point", "--n", &n.to_string(), "--eta", &eta.to_string()])
             .args(["--warmup", &warmup.to_string(), "--timed", &timed(n).to_string()])
+            .args(["--neighbourhood", args.neighbourhood.name()])
             .output()
             .context("running a benchmark point")?;
         if !output.status.success() {
@@ -365,8 +374,11 @@ fn bench(args: BenchArgs) -> Result<ExitCode> {
         results.push(point);
     }
     std::fs::create_dir_all(&args.out).with_context(|| args.out.display().to_string())?;
-    let command = if args.quick { "collide bench --quick" } else { "collide bench" };
-    let md = markdown(&results, command, &collide::lab::report::machine());
+    let mut command = String::from(if args.quick { "collide bench --quick" } else { "collide bench" });
+    if args.neighbourhood != Neighbourhood::Auto {
+        command += &format!(" --neighbourhood {}", args.neighbourhood);
+    }
+    let md = markdown(&results, &command, &collide::lab::report::machine());
     write_atomic(&args.out.join("bench.json"), serde_json::to_string_pretty(&results)?.as_bytes())?;
     write_atomic(&args.out.join("bench.md"), md.as_bytes())?;
     collide::lab::plot::draw(&chart(&results), &args.out.join("collisions_per_second.svg"))

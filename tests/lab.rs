@@ -262,13 +262,21 @@ fn equipartition_check_can_fail() {
 /// One small benchmark point, its table row and its chart (speed itself is never asserted).
 #[test]
 fn bench_point_table_and_chart() {
+    use collide::engine::Neighbourhood;
     use collide::lab::bench::{chart, markdown, measure};
-    let p = measure(300, 0.6, 1, 5_000, 1).unwrap();
+    // Both neighbourhoods can be asked for; the point records which one ran, and both see
+    // the same collisions (bit-identical trajectories), so the same event counts but for
+    // the neighbourhood updates themselves.
+    let lists = measure(300, 0.6, Neighbourhood::Lists, 1, 5_000, 1).unwrap();
+    let p = measure(300, 0.6, Neighbourhood::Grid, 1, 5_000, 1).unwrap();
+    assert!(lists.lists && !p.lists && lists.neighbourhood == Neighbourhood::Lists);
+    assert_eq!((lists.events_by_kind.pair, lists.events_by_kind.wall), (p.events_by_kind.pair, p.events_by_kind.wall));
+    assert_ne!(lists.events_by_kind.rebuild, p.events_by_kind.rebuild);
     assert_eq!(p.events_by_kind.pair, 5_000);
     assert!(p.collisions_per_second > 0.0 && p.ns_per_collision > 0.0);
     assert!(p.engine_bytes_per_particle > 100.0, "particles alone take more: {}", p.engine_bytes_per_particle);
     let md = markdown(&[p.clone()], "collide bench --quick", "test machine");
-    assert!(md.contains("| 300 | 0.6 |") && md.contains("test machine") && md.contains("collide bench --quick"));
+    assert!(md.contains("| 300 | 0.6 | grid |") && md.contains("test machine") && md.contains("collide bench --quick"));
     let dir = out("bench-chart");
     std::fs::create_dir_all(&dir).unwrap();
     collide::lab::plot::draw(&chart(&[p]), &dir.join("c.svg")).unwrap();

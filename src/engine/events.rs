@@ -96,12 +96,18 @@ pub fn short_axes<const D: usize>(sim_box: &SimBox<D>, reach: f64) -> [bool; D] 
     short
 }
 
-/// When particles `pi`, `pj` (`i < j`) next touch while approaching, as an absolute time.
+/// When particles `pi`, `pj` next touch while approaching, as an absolute time.
 ///
 /// The image of `j` is the one nearest to `i` at the current time `now` (and, along
 /// `short` axes, the images one box length to either side, the earliest contact winning);
-/// the contact itself is computed from the later of the two update times, so for a given
-/// image the answer is a pure function of the two states.
+/// the contact itself is computed from the later of the two update times `t0`, so for a
+/// given image the answer is a pure function of the two states. It is also the same for
+/// `(pj, pi)` as for `(pi, pj)`, to the bit: the kernel is given `i` at the origin and `j`
+/// at the separation `Δr = (r_j(t0) − r_i(t0)) + n·L` (`n` the image counts), and swapping
+/// the pair negates `Δr` and `Δv` exactly (rounding to nearest is symmetric under negation;
+/// the counts are odd functions of the separation), which leaves every product the kernel
+/// forms unchanged. So a pair needs no agreed order: the batch search builds its lanes
+/// without a select per pair on which particle comes first.
 pub fn predict_pair<const D: usize>(
     pi: &Particle<D>,
     pj: &Particle<D>,
@@ -142,10 +148,10 @@ pub fn predict_pair_within<const D: usize>(
     let base = sim_box.minimum_image_count(&(pj.position_at(now) - pi.position_at(now)));
     let t0 = pi.time.max(pj.time);
     let h = relative_horizon(horizon, t0);
-    let (ri, rj) = (pi.position_at(t0), pj.position_at(t0));
-    let a = Ball { position: ri.into(), velocity: pi.velocity.into(), radius: pi.radius };
+    let d = pj.position_at(t0) - pi.position_at(t0);
+    let a = Ball { position: [0.0; D], velocity: pi.velocity.into(), radius: pi.radius };
     let earliest = |shift: &SVector<f64, D>| {
-        let b = Ball { position: (rj + shift).into(), velocity: pj.velocity.into(), radius: pj.radius };
+        let b = Ball { position: (d + shift).into(), velocity: pj.velocity.into(), radius: pj.radius };
         absolute(contact_time_within(&a, &b, h)?, t0)
     };
     // Every combination of −1, 0, +1 box lengths along the short axes.
@@ -237,10 +243,11 @@ pub const LANES: usize = 8;
 ///
 /// The balls are exactly those [`pair_balls`] forms (so the certified intervals are
 /// [`bracket_pair`]'s to the bit), but built lane by lane without branches: the neighbours'
-/// states are gathered first, then the positions, image counts and the order of the pair
-/// (lower index first) are computed for all lanes at once as selects, which the compiler
-/// vectorizes. Built one pair at a time, the lanes cost twice what the kernel did (profile at
-/// N = 10⁴, η = 0.65).
+/// states are gathered first, then the separations and image counts are computed for all
+/// lanes at once, which the compiler vectorizes. Built one pair at a time, the lanes cost
+/// twice what the kernel did (profile at N = 10⁴, η = 0.65); since `predict_pair` no longer
+/// depends on which particle of a pair comes first, the selects that put the lower index
+/// first in every lane are gone too (7 636 → … instructions per collision, callgrind).
 #[inline]
 #[allow(clippy::too_many_arguments)]
 pub fn bracket_neighbours<const D: usize>(
@@ -260,7 +267,6 @@ pub fn bracket_neighbours<const D: usize>(
     let mut qv = [[0.0; LANES]; D];
     let mut qt = [0.0; LANES];
     let mut qr = [0.0; LANES];
-    let mut i_first = [false; LANES];
     for k in 0..LANES {
         let j = std::hint::select_unpredictable(k < len, js[k] as usize, i).min(last);
         let q = &particles[j];
@@ -270,38 +276,34 @@ pub fn bracket_neighbours<const D: usize>(
         }
         qt[k] = q.time;
         qr[k] = q.radius;
-        i_first[k] = i < j;
     }
-    // The balls, as `pair_balls` forms them: `base` from the separation at `now` (lower index
-    // to higher; `P − Q` is exactly `−(Q − P)`), positions at `t0`, the later update time.
+    // The balls, as `pair_balls` forms them: `i` at the origin (the same for every lane) and
+    // the neighbour at its separation at `t0`, the later update time, from `i` to the image
+    // nearest to `i` at `now`.
     let mut first = BallLanes::<D, LANES>::default();
     let mut second = BallLanes::<D, LANES>::default();
     let mut t0 = [0.0; LANES];
     let mut separation = [[0.0; LANES]; D];
-    let mut higher = [[0.0; LANES]; D];
+    let mut apart = [[0.0; LANES]; D];
     let mut decided = [[true; LANES]; D];
     for k in 0..LANES {
         let t = p.time.max(qt[k]);
         t0[k] = t;
-        let ij = i_first[k];
         for a in 0..D {
-            let e = (qx[a][k] + qv[a][k] * (now - qt[k])) - (p.position[a] + p.velocity[a] * (now - p.time));
-            let d = if ij { e } else { -e };
+            let d = (qx[a][k] + qv[a][k] * (now - qt[k])) - (p.position[a] + p.velocity[a] * (now - p.time));
             let (count, known) = image_count_by_comparison(d, sim_box.lengths[a]);
             let periodic = sim_box.boundary[a] == Boundary::Periodic;
             let count = if periodic { count } else { 0.0 };
-            let p_at = p.position[a] + p.velocity[a] * (t - p.time);
-            let q_at = qx[a][k] + qv[a][k] * (t - qt[k]);
-            first.position[a][k] = if ij { p_at } else { q_at };
-            higher[a][k] = if ij { q_at } else { p_at };
-            second.position[a][k] = higher[a][k] + count * sim_box.lengths[a];
-            first.velocity[a][k] = if ij { p.velocity[a] } else { qv[a][k] };
-            second.velocity[a][k] = if ij { qv[a][k] } else { p.velocity[a] };
+            let at = (qx[a][k] + qv[a][k] * (t - qt[k])) - (p.position[a] + p.velocity[a] * (t - p.time));
+            first.velocity[a][k] = p.velocity[a];
+            second.position[a][k] = at + count * sim_box.lengths[a];
+            second.velocity[a][k] = qv[a][k];
             separation[a][k] = d;
+            apart[a][k] = at;
             decided[a][k] = known | !periodic;
         }
-        first.radius[k] = if ij { p.radius } else { qr[k] };
-        second.radius[k] = if ij { qr[k] } else { p.radius };
+        first.radius[k] = p.radius;
+        second.radius[k] = qr[k];
     }
     // A separation near half a box length (or beyond 3/2) needs the division: rare.
     if decided.iter().flatten().any(|&known| !known) {
@@ -309,7 +311,7 @@ pub fn bracket_neighbours<const D: usize>(
             for k in 0..LANES {
                 if !decided[a][k] {
                     let count = image_count(separation[a][k], sim_box.lengths[a]);
-                    second.position[a][k] = higher[a][k] + count * sim_box.lengths[a];
+                    second.position[a][k] = apart[a][k] + count * sim_box.lengths[a];
                 }
             }
         }
@@ -334,8 +336,9 @@ pub fn bracket_neighbours<const D: usize>(
     m[0]
 }
 
-/// The two balls the kernel is given for a pair when no axis is short: positions at `t0`,
-/// the later of the two update times, with `j` at its image nearest to `i` at `now`; and `t0`.
+/// The two balls the kernel is given for a pair when no axis is short, and `t0`, the later
+/// of the two update times: `i` at the origin, `j` at the separation at `t0` from `i` to
+/// `j`'s image nearest to `i` at `now` (see [`predict_pair`] for why this form).
 #[inline]
 fn pair_balls<const D: usize>(
     pi: &Particle<D>,
@@ -345,13 +348,9 @@ fn pair_balls<const D: usize>(
 ) -> (Ball<D>, Ball<D>, f64) {
     let base = sim_box.minimum_image_count(&(pj.position_at(now) - pi.position_at(now)));
     let t0 = pi.time.max(pj.time);
-    let (ri, rj) = (pi.position_at(t0), pj.position_at(t0));
-    let a = Ball { position: ri.into(), velocity: pi.velocity.into(), radius: pi.radius };
-    let b = Ball {
-        position: (rj + base.component_mul(&sim_box.lengths)).into(),
-        velocity: pj.velocity.into(),
-        radius: pj.radius,
-    };
+    let d = (pj.position_at(t0) - pi.position_at(t0)) + base.component_mul(&sim_box.lengths);
+    let a = Ball { position: [0.0; D], velocity: pi.velocity.into(), radius: pi.radius };
+    let b = Ball { position: d.into(), velocity: pj.velocity.into(), radius: pj.radius };
     (a, b, t0)
 }
 

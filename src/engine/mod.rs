@@ -26,6 +26,6 @@ pub mod simulation;
 
 pub use collision::{Body, Impulse, Restitution, RestitutionError, resolve_pair};
 pub use geometry::{Boundary, Particle, SimBox};
-pub use neighbours::Neighbourhood;
+pub use neighbours::{Neighbourhood, UnknownNeighbourhood};
 pub use reference::ReferenceSimulation;
 pub use simulation::{EventCounts, Outcome, OverlapAudit, SetupError, Simulation, SimulationState};

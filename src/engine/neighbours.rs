@@ -132,6 +132,49 @@ pub enum Neighbourhood {
     Lists,
 }
 
+impl Neighbourhood {
+    /// The names [`FromStr`](std::str::FromStr) accepts (as in the saved state).
+    pub const NAMES: [&'static str; 3] = ["auto", "grid", "lists"];
+
+    /// The name (as in the saved state).
+    pub fn name(self) -> &'static str {
+        match self {
+            Neighbourhood::Auto => "auto",
+            Neighbourhood::Grid => "grid",
+            Neighbourhood::Lists => "lists",
+        }
+    }
+}
+
+impl std::fmt::Display for Neighbourhood {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(self.name())
+    }
+}
+
+/// A neighbourhood name that is none of [`Neighbourhood::NAMES`].
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct UnknownNeighbourhood(pub String);
+
+impl std::fmt::Display for UnknownNeighbourhood {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(f, "unknown neighbourhood {:?}: expected one of {}", self.0, Neighbourhood::NAMES.join(", "))
+    }
+}
+
+impl std::error::Error for UnknownNeighbourhood {}
+
+impl std::str::FromStr for Neighbourhood {
+    type Err = UnknownNeighbourhood;
+
+    fn from_str(s: &str) -> Result<Self, Self::Err> {
+        [Neighbourhood::Auto, Neighbourhood::Grid, Neighbourhood::Lists]
+            .into_iter()
+            .find(|n| n.name() == s)
+            .ok_or_else(|| UnknownNeighbourhood(s.to_string()))
+    }
+}
+
 /// The skin for lists, or `None` for the grid that follows the particles: lists only in 2D
 /// (in 3D a list of [`CAPACITY`] holds fewer than a dense fluid's neighbours), with no short
 /// periodic axis (`allow`), and for [`Neighbourhood::Auto`] from [`LISTS_FROM`] and

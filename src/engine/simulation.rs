@@ -688,8 +688,7 @@ impl<const D: usize> Simulation<D> {
                 let t = if lo == hi && lo < f64::INFINITY {
                     Some(lo)
                 } else {
-                    let (a, b) = if i < j { (p, q) } else { (q, p) };
-                    predict_pair(a, b, &self.sim_box, now, &self.short).map(|t| t.max(now))
+                    predict_pair(p, q, &self.sim_box, now, &self.short).map(|t| t.max(now))
                 };
                 if let Some(t) = t {
                     let kind = PendingKind::Pair { partner: j as u32, partner_events: q.events };
@@ -725,8 +724,7 @@ impl<const D: usize> Simulation<D> {
                 continue;
             }
             let q = &self.particles[j];
-            let (a, b) = if i < j { (p, q) } else { (q, p) };
-            let exact = match bracket_pair(a, b, &self.sim_box, now, &self.short, bound) {
+            let exact = match bracket_pair(p, q, &self.sim_box, now, &self.short, bound) {
                 PairBracket::Beyond | PairBracket::Known(None) => continue,
                 PairBracket::Known(Some(t)) => t,
                 PairBracket::Between { lo, hi } if n_hits < HITS => {
@@ -737,7 +735,7 @@ impl<const D: usize> Simulation<D> {
                 }
                 // No room left to defer it: evaluate it now.
                 PairBracket::Between { .. } => {
-                    predict_pair(a, b, &self.sim_box, now, &self.short).expect("a bracketed contact")
+                    predict_pair(p, q, &self.sim_box, now, &self.short).expect("a bracketed contact")
                 }
             };
             let kind = PendingKind::Pair { partner: j as u32, partner_events: q.events };
@@ -751,8 +749,7 @@ impl<const D: usize> Simulation<D> {
             }
             let j = j as usize;
             let q = &self.particles[j];
-            let (a, b) = if i < j { (p, q) } else { (q, p) };
-            let t = predict_pair(a, b, &self.sim_box, now, &self.short).expect("a bracketed contact");
+            let t = predict_pair(p, q, &self.sim_box, now, &self.short).expect("a bracketed contact");
             let kind = PendingKind::Pair { partner: j as u32, partner_events: q.events };
             consider(best, Pending { time: t.max(now), kind });
         }

@@ -9,7 +9,7 @@
 
 use super::plot::{Chart, Series};
 use crate::engine::init::{Placement, Species, Velocities, box_for_packing_fraction, initial_particles};
-use crate::engine::{Boundary, EventCounts, Simulation};
+use crate::engine::{Boundary, EventCounts, Neighbourhood, Simulation};
 use serde::{Deserialize, Serialize};
 use std::time::Instant;
 
@@ -20,6 +20,12 @@ pub struct BenchPoint {
     pub n_particles: usize,
     /// Packing fraction.
     pub packing_fraction: f64,
+    /// The neighbourhood asked for (`auto`, `grid` or `lists`).
+    #[serde(default)]
+    pub neighbourhood: Neighbourhood,
+    /// Whether neighbour lists were in use (else the grid that follows the particles).
+    #[serde(default)]
+    pub lists: bool,
     /// Untimed warm-up collisions.
     pub warmup_collisions: u64,
     /// Timed pair collisions.
@@ -52,13 +58,20 @@ pub fn peak_rss_bytes() -> Option<u64> {
 }
 
 /// Measures one point: `warmup_per_particle` untimed collisions per particle, then
-/// `timed` collisions.
-pub fn measure(n: usize, eta: f64, warmup_per_particle: u64, timed: u64, seed: u64) -> Result<BenchPoint, String> {
+/// `timed` collisions, with the neighbourhood asked for.
+pub fn measure(
+    n: usize,
+    eta: f64,
+    neighbourhood: Neighbourhood,
+    warmup_per_particle: u64,
+    timed: u64,
+    seed: u64,
+) -> Result<BenchPoint, String> {
     let species = vec![Species { count: n, radius: 0.5, mass: 1.0 }];
     let sim_box = box_for_packing_fraction(&species, eta, [Boundary::Periodic; 2], Placement::Triangular, 1.0);
     let particles = initial_particles(&species, &sim_box, Placement::Triangular, Velocities::Maxwell, 1.0, seed)
         .map_err(|e| e.to_string())?;
-    let mut sim = Simulation::new(particles, sim_box).map_err(|e| e.to_string())?;
+    let mut sim = Simulation::with_neighbourhood(particles, sim_box, neighbourhood).map_err(|e| e.to_string())?;
     let warmup = warmup_per_particle * n as u64;
     while sim.counts().pair < warmup {
         sim.step().ok_or("the gas stopped")?;
@@ -74,6 +87,8 @@ pub fn measure(n: usize, eta: f64, warmup_per_particle: u64, timed: u64, seed: u
     Ok(BenchPoint {
         n_particles: n,
         packing_fraction: eta,
+        neighbourhood,
+        lists: sim.lists(),
         warmup_collisions: warmup,
         collisions: timed,
         seconds,
@@ -113,8 +128,8 @@ pub fn today() -> String {
 pub fn markdown(points: &[BenchPoint], command: &str, machine: &str) -> String {
     let mut md = format!(
         "# collide benchmark report\n\n{} · collide {} · {machine} · one core\n\nCommand: `{command}`\n\n\
-         | N | η | collisions/s | ns/collision | events/s | pair : wall : rebuild : stale per collision | engine bytes/particle | peak RSS bytes/particle |\n\
-         |---|---|---|---|---|---|---|---|\n",
+         | N | η | neighbourhood | collisions/s | ns/collision | events/s | pair : wall : rebuild : stale per collision | engine bytes/particle | peak RSS bytes/particle |\n\
+         |---|---|---|---|---|---|---|---|---|\n",
         today(),
         env!("CARGO_PKG_VERSION")
     );
@@ -122,9 +137,10 @@ pub fn markdown(points: &[BenchPoint], command: &str, machine: &str) -> String {
         let e = &p.events_by_kind;
         let per = |x: u64| x as f64 / e.pair.max(1) as f64;
         md.push_str(&format!(
-            "| {} | {} | {:.3e} | {:.0} | {:.3e} | 1 : {:.2} : {:.2} : {:.2} | {:.0} | {} |\n",
+            "| {} | {} | {} | {:.3e} | {:.0} | {:.3e} | 1 : {:.2} : {:.2} : {:.2} | {:.0} | {} |\n",
             p.n_particles,
             p.packing_fraction,
+            if p.lists { "lists" } else { "grid" },
             p.collisions_per_second,
             p.ns_per_collision,
             p.events_per_second,
