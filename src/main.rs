@@ -90,8 +90,8 @@ struct BenchArgs {
     /// Output directory.
     #[arg(long, default_value = "bench")]
     out: PathBuf,
-    /// How particles find their neighbours: `auto` (lists for dense systems of 3·2¹⁴
-    /// disks or more, the grid elsewhere), `grid` or `lists`.
+    /// How particles find their neighbours: `auto` (lists from packing fraction 0.63 on,
+    /// the grid below), `grid` or `lists`.
     #[arg(long, default_value_t = Neighbourhood::Auto)]
     neighbourhood: Neighbourhood,
 }

@@ -146,7 +146,8 @@ fn unequal_masses_head_on_follow_the_1d_formula() {
 }
 
 /// Dense lattice starts (many simultaneous near-contacts, "now" events, several cells per
-/// axis) through the same comparison with the reference.
+/// axis) through the same comparison with the reference, with the grid that follows the
+/// particles (the automatic choice at η = 0.7 would keep lists, tested below).
 #[test]
 fn fast_engine_matches_the_reference_from_dense_lattices() {
     for (placement, eta, boundary) in
@@ -155,16 +156,15 @@ fn fast_engine_matches_the_reference_from_dense_lattices() {
         let species = vec![Species { count: 64, radius: 0.5, mass: 1.0 }];
         let sim_box = box_for_packing_fraction(&species, eta, boundary, placement, 1.0);
         let particles = initial_particles(&species, &sim_box, placement, Velocities::Maxwell, 1.0, 9).unwrap();
-        let fast = Simulation::new(particles.clone(), sim_box).unwrap();
-        assert!(fast.cell_counts().iter().all(|&n| n >= 4), "{:?}", fast.cell_counts());
+        let fast = Simulation::with_neighbourhood(particles.clone(), sim_box, Neighbourhood::Grid).unwrap();
+        assert!(!fast.lists() && fast.cell_counts().iter().all(|&n| n >= 4), "{:?}", fast.cell_counts());
         let slow = ReferenceSimulation::new(particles, sim_box);
         assert_same_collisions(fast, slow, 5000, &format!("{placement:?}"));
     }
 }
 
-/// With neighbour lists forced on (the automatic choice keeps them for dense systems of
-/// 3·2¹⁴ particles or more, too many for the reference), the fast engine still produces the
-/// reference's collisions bit for bit: random systems with walls, periodic axes and
+/// With neighbour lists forced on (the automatic choice keeps them only from packing
+/// fraction 0.63 on), the fast engine still produces the reference's collisions bit for bit: random systems with walls, periodic axes and
 /// mixtures, and dense lattices.
 #[test]
 fn fast_engine_with_lists_matches_the_reference() {

@@ -18,15 +18,15 @@
 //! relies on this — a particle that changes course predicts only against its own list, so
 //! every particle that can reach it must be on it. The separation of two centres is
 //! computed as the exact negative from either side (`cⱼ − cᵢ = −(cᵢ − cⱼ)` in floating
-//! point, and the minimum image count is `−round(d/L)`, odd in `d`), so both sides agree.
+//! point, and the image count is `round(d/L)`, odd in `d`), so both sides agree.
 //!
 //! A list holds at most [`CAPACITY`] neighbours in one 32-byte block (a contiguous row, read
 //! by the batch kernel eight lanes at a time). A particle with more is *crowded*: it keeps
 //! no list and searches the cell grid around its centre instead, which holds everyone in
 //! range (cells are `R` wide); it gets a list again at its next rebuild if the neighbours
 //! then fit. With short periodic axes (several images of one pair in range), in 3D, and for
-//! [`Neighbourhood::Auto`] below [`LISTS_FROM`] or [`LISTS_FROM_N`], no lists are kept and
-//! the grid follows the particles.
+//! [`Neighbourhood::Auto`] below [`LISTS_FROM`], no lists are kept and the grid follows
+//! the particles.
 //!
 //! With lists, the cell grid ([`Cells`]) holds each particle by its centre, so a particle
 //! changes cell only when it rebuilds, with no crossing events.
@@ -103,18 +103,16 @@ impl List {
 }
 
 /// Lists are kept (by [`Neighbourhood::Auto`]) from this packing fraction on,
-/// `n·π(reach/2)²` with `n` the number density, and from [`LISTS_FROM_N`] particles.
-/// Measured at η = 0.65 (alternating runs, medians of 3, 10⁶ collisions/s, lists against
-/// the grid): 1.51 vs 1.56 at N = 10⁴, 1.10 vs 1.19 at 3·10⁴, 1.02 vs 0.93 at 10⁵, 0.88 vs
-/// 0.64 at 10⁶; at η = 0.6 and N = 10⁵ 0.83 vs 0.85; at η = 0.5, 0.62 vs 0.81 at 10⁵ and
-/// 0.50 vs 0.59 at 10⁶. Lists save the walk through the cell lists and most of the cache
-/// misses around a collision, which pays only once the state is far out of cache; at lower
-/// densities a particle leaves its skin so often that the rebuilds cost more.
-pub const LISTS_FROM: f64 = 0.62;
-
-/// The fewest particles for which [`Neighbourhood::Auto`] keeps lists (3·2¹⁴, where the
-/// engine's state outgrows the caches; see [`LISTS_FROM`]).
-pub const LISTS_FROM_N: usize = 3 << 14;
+/// `n·π(reach/2)²` with `n` the number density, at every N. Measured with the rebuild of
+/// the sixth session (alternating runs, `--neighbourhood grid` and `lists`, medians of 4,
+/// 10⁶ collisions/s, lists against the grid): at η = 0.65, 2.04 vs 1.94 at N = 10³, 1.90 vs
+/// 1.74 at 3·10³, 1.99 vs 1.87 at 10⁴, 1.32 vs 1.32 at 3·10⁴ (and 1.02 vs 0.93 at 10⁵, 0.88
+/// vs 0.64 at 10⁶ in the fifth session); at N = 10⁴, 2.04 vs 1.72 at η = 0.7, 1.74 vs 1.65
+/// at 0.64, 1.37 vs 1.44 at 0.62, 1.65 vs 1.75 at 0.6 and 1.36 vs 1.64 at 0.5. Lists save
+/// the walk through the cell lists (and, at large N, most of the cache misses around a
+/// collision); at lower densities a particle leaves its skin so often that the rebuilds cost
+/// more.
+pub const LISTS_FROM: f64 = 0.63;
 
 /// The mean number of particles the list range is sized to hold, `n·πR²`. Measured at
 /// η = 0.65, N = 10⁴ (skin as a fraction of the contact distance: collisions/s, rebuilds
@@ -127,7 +125,7 @@ pub const RANGE_HOLDS: f64 = 8.4;
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
 #[serde(rename_all = "snake_case")]
 pub enum Neighbourhood {
-    /// Lists where they pay ([`LISTS_FROM`], [`LISTS_FROM_N`]), the grid elsewhere.
+    /// Lists where they pay (from [`LISTS_FROM`]), the grid elsewhere.
     #[default]
     Auto,
     /// A grid of cells one contact distance wide following the particles (an event at each
@@ -183,8 +181,7 @@ impl std::str::FromStr for Neighbourhood {
 
 /// The skin for lists, or `None` for the grid that follows the particles: lists only in 2D
 /// (in 3D a list of [`CAPACITY`] holds fewer than a dense fluid's neighbours), with no short
-/// periodic axis (`allow`), and for [`Neighbourhood::Auto`] from [`LISTS_FROM`] and
-/// [`LISTS_FROM_N`] on. The skin makes the range hold [`RANGE_HOLDS`] particles, within
+/// periodic axis (`allow`), and for [`Neighbourhood::Auto`] from [`LISTS_FROM`] on. The skin makes the range hold [`RANGE_HOLDS`] particles, within
 /// `[reach/4, reach]`, and short enough that a range plus a skin stays under half of every
 /// periodic box length (one image of a pair in range).
 fn skin_for<const D: usize>(
@@ -197,7 +194,7 @@ fn skin_for<const D: usize>(
     let density = n as f64 / sim_box.volume();
     let eta = density * std::f64::consts::PI * 0.25 * reach * reach;
     let wanted = match choice {
-        Neighbourhood::Auto => eta >= LISTS_FROM && n >= LISTS_FROM_N,
+        Neighbourhood::Auto => eta >= LISTS_FROM,
         Neighbourhood::Grid => false,
         Neighbourhood::Lists => true,
     };
