@@ -6,15 +6,15 @@
 //! `engine/parts` times pieces of one collision's work at N = 10⁴, η = 0.65, to show where
 //! the time goes: `bracket_pair` over every pair of a warmed-up state closer than 1.8σ (per
 //! pair); `bracket_neighbours`, the batch version the engine runs, over every particle's
-//! cell neighbours (per particle, i.e. per prediction); and replacing the event of the
-//! particle at the root of the queue's tree (per update; the root owner's is the longest
-//! walk, as after every collision).
+//! cell neighbours (per particle, i.e. per prediction); and replacing the earliest event of
+//! a queue of 10⁴ by a later one, with either structure (per update, as after every
+//! collision; in the tree the root owner's is the longest walk).
 
 use collide::engine::events::{
     LANES, PairBracket, Pending, PendingKind, bracket_neighbours, bracket_pair, pair_positions,
 };
 use collide::engine::init::{Placement, Species, Velocities, box_for_packing_fraction, initial_particles};
-use collide::engine::queue::EventQueue;
+use collide::engine::queue::{EventQueue, QueueKind};
 use collide::engine::{Boundary, Simulation};
 use criterion::{BenchmarkId, Criterion, Throughput, criterion_group, criterion_main};
 use rand::rngs::Xoshiro256PlusPlus;
@@ -108,15 +108,18 @@ fn parts(c: &mut Criterion) {
     let wall = |time| Pending { time, kind: PendingKind::Wall { axis: 0, upper: true } };
     let mut rng = Xoshiro256PlusPlus::seed_from_u64(3);
     let mut next = move || rng.random_range(0.0..100_000.0f64).floor();
-    let mut queue = EventQueue::new((0..10_000).map(|_| wall(next())).collect());
+    let start: Vec<Pending> = (0..10_000).map(|_| wall(next())).collect();
     group.throughput(Throughput::Elements(1));
-    group.bench_function("queue_set_root", |b| {
-        b.iter(|| {
-            let (owner, first) = queue.first();
-            let t = first.time + next();
-            queue.set(owner, wall(t));
-        })
-    });
+    for (name, kind) in [("queue_set_first/tree", QueueKind::Tree), ("queue_set_first/calendar", QueueKind::Calendar)] {
+        let mut queue = EventQueue::new(start.clone(), kind);
+        group.bench_function(name, |b| {
+            b.iter(|| {
+                let (owner, first) = queue.first();
+                let t = first.time + next();
+                queue.set(owner, wall(t));
+            })
+        });
+    }
     group.finish();
 }
 

@@ -1,4 +1,4 @@
-//! The event queue: one [`Pending`] event per particle in a 4-ary tournament tree.
+//! The tournament tree: one [`Pending`] event per particle in a 4-ary tree of winners.
 //!
 //! Every particle owns exactly one slot, so the queue never grows and never holds stale
 //! copies (a binary heap of every prediction held about five stale events per collision at
@@ -13,13 +13,14 @@
 //! the root's owner costs the same (63 ns in `engine/parts/queue_set_root`, three
 //! interleaved runs each), the tree takes a third of the memory (N/3 nodes instead of N),
 //! and the whole engine measured +5 % (median of five interleaved runs, within the noise).
-//! The four children of a node share one cache line (see [`EventQueue`]): 16 bytes per
+//! The four children of a node share one cache line (see [`Tree`]): 16 bytes per
 //! particle for the events and about 5 for the nodes.
 //!
 //! The order is the engine's total order ([`Pending::before`]): by time, then by kind, then
 //! by particles and axes — so the earliest event never depends on how it was reached.
 
-use super::events::{Pending, PendingKind};
+use super::Slot;
+use crate::engine::events::Pending;
 
 /// Children per internal node.
 const ARITY: usize = 4;
@@ -38,49 +39,6 @@ const NO_NODE: Node = Node { time: f64::INFINITY, owner: 0 };
 #[repr(C, align(64))]
 struct Quad([Node; ARITY]);
 
-/// A [`Pending`] event packed into 16 bytes: a pair is `(partner, partner's count)`; the
-/// other kinds put a tag that no particle index reaches (indices stay below
-/// [`MAX_PARTICLES`](super::simulation::MAX_PARTICLES)) where the partner would be.
-#[derive(Clone, Copy, Debug)]
-#[repr(C)]
-struct Slot {
-    time: f64,
-    who: u32,
-    what: u32,
-}
-
-const NOTHING_TAG: u32 = u32::MAX;
-const WALL_TAG: u32 = u32::MAX - 1;
-const REBUILD_TAG: u32 = u32::MAX - 2;
-
-impl Slot {
-    #[inline(always)]
-    fn pack(e: Pending) -> Slot {
-        let (who, what) = match e.kind {
-            PendingKind::Pair { partner, partner_events } => {
-                debug_assert!(partner < REBUILD_TAG);
-                (partner, partner_events)
-            }
-            PendingKind::Wall { axis, upper } => (WALL_TAG, axis as u32 | (upper as u32) << 8),
-            PendingKind::Rebuild => (REBUILD_TAG, 0),
-            PendingKind::Nothing => (NOTHING_TAG, 0),
-        };
-        Slot { time: e.time, who, what }
-    }
-
-    #[inline(always)]
-    fn unpack(self) -> Pending {
-        let (axis, flag) = (self.what as u8, self.what >> 8 != 0);
-        let kind = match self.who {
-            NOTHING_TAG => PendingKind::Nothing,
-            WALL_TAG => PendingKind::Wall { axis, upper: flag },
-            REBUILD_TAG => PendingKind::Rebuild,
-            partner => PendingKind::Pair { partner, partner_events: self.what },
-        };
-        Pending { time: self.time, kind }
-    }
-}
-
 /// Four sibling slots, one cache line.
 #[derive(Clone, Copy, Debug)]
 #[repr(C, align(64))]
@@ -94,7 +52,7 @@ struct Group([Slot; ARITY]);
 /// that siblings share a group). With 24-byte events and 16-byte nodes in plain arrays the
 /// four children straddled two lines at every level.
 #[derive(Clone, Debug)]
-pub struct EventQueue {
+pub struct Tree {
     /// The slots: particle `p`'s is number `p + shift` (the padding after the particles
     /// holds nothing).
     groups: Vec<Group>,
@@ -109,11 +67,11 @@ pub struct EventQueue {
     quads: Vec<Quad>,
 }
 
-impl EventQueue {
+impl Tree {
     /// A queue over `pending` (one event per particle, at most
-    /// [`MAX_PARTICLES`](super::simulation::MAX_PARTICLES)).
+    /// [`MAX_PARTICLES`](crate::engine::simulation::MAX_PARTICLES)).
     pub fn new(pending: Vec<Pending>) -> Self {
-        let mut queue = EventQueue::nothing(pending.len());
+        let mut queue = Tree::nothing(pending.len());
         for (p, e) in pending.into_iter().enumerate() {
             *queue.slot_mut(p) = Slot::pack(e);
         }
@@ -124,7 +82,7 @@ impl EventQueue {
     /// A queue of `n` particles with nothing pending (no temporary list of events: at
     /// N = 10⁶ one cost 24 MB of peak memory).
     pub fn nothing(n: usize) -> Self {
-        assert!(n >= 1 && n <= super::simulation::MAX_PARTICLES, "1 ≤ n ≤ 2³² − 5 particles");
+        assert!(n >= 1 && n <= crate::engine::simulation::MAX_PARTICLES, "1 ≤ n ≤ 2³² − 5 particles");
         let mut slots = n;
         while (slots - 1) % (ARITY - 1) != 0 {
             slots += 1;
@@ -133,7 +91,7 @@ impl EventQueue {
         // The children of node k begin at tree position 4k + 1, slot 4k + 1 − m.
         let shift = (m + ARITY - 1) % ARITY;
         let empty = Group([Slot::pack(Pending::NOTHING); ARITY]);
-        let mut queue = EventQueue {
+        let mut queue = Tree {
             groups: vec![empty; (slots + shift).div_ceil(ARITY)],
             shift,
             n,
@@ -245,7 +203,7 @@ impl EventQueue {
     /// Prefetches particle `owner`'s slot.
     #[inline]
     pub fn prefetch_slot(&self, owner: usize) {
-        super::prefetch::prefetch(self.slot(owner));
+        crate::engine::prefetch::prefetch(self.slot(owner));
     }
 
     /// Prefetches the lowest levels of the path above `owner`'s slot (the upper levels stay
@@ -261,9 +219,9 @@ impl EventQueue {
             k = (k - 1) / ARITY;
             let c = ARITY * k + 1;
             if c >= m {
-                super::prefetch::prefetch(&self.groups[(c - m + self.shift) / ARITY]);
+                crate::engine::prefetch::prefetch(&self.groups[(c - m + self.shift) / ARITY]);
             } else if let Some(quad) = self.quads.get(k) {
-                super::prefetch::prefetch(quad);
+                crate::engine::prefetch::prefetch(quad);
             }
         }
     }
@@ -324,90 +282,5 @@ impl EventQueue {
     fn tie_b_first(&self, a: Node, b: Node) -> bool {
         let key = |x: Node| self.slot(x.owner as usize).unpack().key(x.owner);
         key(b) < key(a)
-    }
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-    use crate::engine::events::PendingKind;
-    use rand::rngs::Xoshiro256PlusPlus;
-    use rand::{RngExt, SeedableRng};
-
-    fn wall(time: f64) -> Pending {
-        Pending { time, kind: PendingKind::Wall { axis: 0, upper: true } }
-    }
-
-    /// Every kind of event comes back out of its 16-byte slot as it went in, at the
-    /// extremes of every field.
-    #[test]
-    fn slots_keep_every_event() {
-        let largest = crate::engine::simulation::MAX_PARTICLES as u32 - 1;
-        let mut kinds = vec![PendingKind::Nothing, PendingKind::Rebuild];
-        for axis in [0u8, 1, 2] {
-            for flag in [false, true] {
-                kinds.push(PendingKind::Wall { axis, upper: flag });
-            }
-        }
-        for partner in [0, 1, largest] {
-            for partner_events in [0, 1, u32::MAX] {
-                kinds.push(PendingKind::Pair { partner, partner_events });
-            }
-        }
-        for kind in kinds {
-            for time in [0.0, -0.0, 1.5, f64::MIN_POSITIVE, f64::INFINITY] {
-                let e = Pending { time, kind };
-                let back = Slot::pack(e).unpack();
-                assert_eq!((back.time.to_bits(), back.kind), (time.to_bits(), kind));
-            }
-        }
-    }
-
-    /// Against a linear scan, after every one of many random replacements, for sizes that
-    /// are and are not powers of two; ties are broken by the owner.
-    #[test]
-    fn first_is_the_minimum_in_the_total_order() {
-        let mut rng = Xoshiro256PlusPlus::seed_from_u64(5);
-        for n in [1usize, 2, 3, 4, 5, 6, 7, 8, 13, 100] {
-            let mut queue = EventQueue::new((0..n).map(|_| Pending::NOTHING).collect());
-            for _ in 0..2000 {
-                let owner = rng.random_range(0..n);
-                // Few distinct times, so that ties are common; sometimes nothing.
-                let r: u32 = rng.random_range(0..9);
-                let event = if r == 8 { Pending::NOTHING } else { wall(r as f64) };
-                queue.set(owner, event);
-                let (got, _) = queue.first();
-                let want = (0..n)
-                    .min_by(|&a, &b| {
-                        let (pa, pb) = (queue.get(a), queue.get(b));
-                        pa.time.total_cmp(&pb.time).then(pa.key(a as u32).cmp(&pb.key(b as u32)))
-                    })
-                    .unwrap();
-                assert_eq!(got, want, "n = {n}");
-            }
-        }
-    }
-
-    /// Against a linear scan: the time of `runner_up(a, b)` is the earliest time among
-    /// all particles but `a` and `b`, for paths that meet low, high and not until the root.
-    #[test]
-    fn runner_up_is_the_earliest_of_the_others() {
-        let mut rng = Xoshiro256PlusPlus::seed_from_u64(11);
-        for n in [3usize, 4, 5, 6, 7, 13, 100, 1000] {
-            let mut queue = EventQueue::new((0..n).map(|_| Pending::NOTHING).collect());
-            for _ in 0..2000 {
-                let owner = rng.random_range(0..n);
-                queue.set(owner, wall(rng.random_range(0.0..1.0)));
-                let (a, b) = (rng.random_range(0..n), rng.random_range(0..n));
-                let got = queue.runner_up(a, b);
-                let want =
-                    (0..n).filter(|&k| k != a && k != b).map(|k| queue.get(k).time).fold(f64::INFINITY, f64::min);
-                // With nobody else pending, any answer will do (there is nothing to prefetch).
-                if want < f64::INFINITY {
-                    assert!(got != a && got != b, "n = {n}, {a}, {b} → {got}");
-                    assert_eq!(queue.get(got).time.to_bits(), want.to_bits(), "n = {n}, {a}, {b}");
-                }
-            }
-        }
     }
 }
