@@ -78,7 +78,7 @@ impl Calendar {
 
     /// A queue of `n` particles with nothing pending.
     pub fn nothing(n: usize) -> Self {
-        assert!(n >= 1 && n <= crate::engine::simulation::MAX_PARTICLES, "1 ≤ n ≤ 2³² − 5 particles");
+        assert!((1..=crate::engine::simulation::MAX_PARTICLES).contains(&n), "1 ≤ n ≤ 2³² − 5 particles");
         let buckets = n.next_power_of_two();
         Calendar {
             slots: vec![Slot::pack(Pending::NOTHING); n],
@@ -219,10 +219,10 @@ impl Calendar {
     pub fn first(&mut self) -> (usize, Pending) {
         self.searches += 1;
         if self.searches > 4 * self.slots.len()
-            || (self.searches % CHECK_EVERY == 0 && self.work > MOST_WORK * CHECK_EVERY)
+            || (self.searches.is_multiple_of(CHECK_EVERY) && self.work > MOST_WORK * CHECK_EVERY)
         {
             self.rebuild();
-        } else if self.searches % CHECK_EVERY == 0 {
+        } else if self.searches.is_multiple_of(CHECK_EVERY) {
             self.work = 0;
         }
         if self.linked == 0 {
