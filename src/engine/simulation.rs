@@ -824,6 +824,7 @@ impl<const D: usize> Simulation<D> {
         for k in 0..self.particles.len() {
             self.predict(k, None);
         }
+        self.queue.refit();
     }
 
     /// The sampling instant `t` is reached.

@@ -103,7 +103,7 @@ impl Calendar {
     /// Chooses `w` from the pending events and links them all again: the mean lead of the
     /// finite times over the earliest, spread over as many buckets as there are events, puts
     /// about one in each bucket at the front (where the lead is small and the events dense).
-    fn rebuild(&mut self) {
+    pub fn rebuild(&mut self) {
         let finite = || self.slots.iter().map(|s| s.time).filter(|t| t.is_finite());
         let (count, earliest) = finite().fold((0usize, f64::INFINITY), |(c, m), t| (c + 1, m.min(t)));
         if count > 0 {

@@ -192,6 +192,15 @@ impl EventQueue {
         }
     }
 
+    /// After every event has been replaced (the first predictions): the calendar chooses its
+    /// bucket width for the new events (it would otherwise notice only after a thousand long
+    /// searches); the tree has nothing to do.
+    pub fn refit(&mut self) {
+        if let EventQueue::Calendar(q) = self {
+            q.rebuild();
+        }
+    }
+
     /// Heap bytes held (capacities).
     pub fn memory_bytes(&self) -> usize {
         match self {
