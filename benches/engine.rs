@@ -11,7 +11,7 @@
 //! collision; in the tree the root owner's is the longest walk).
 
 use collide::engine::events::{
-    LANES, PairBracket, Pending, PendingKind, bracket_neighbours, bracket_pair, pair_positions,
+    LANES, Lanes, PairBracket, Pending, PendingKind, bracket_neighbours, bracket_pair, pair_positions,
 };
 use collide::engine::init::{Placement, Species, Velocities, box_for_packing_fraction, initial_particles};
 use collide::engine::queue::{EventQueue, QueueKind};
@@ -97,7 +97,8 @@ fn parts(c: &mut Criterion) {
                     let (mut lo, mut hi) = ([0.0; LANES], [0.0; LANES]);
                     let mut js = [i as u32; LANES];
                     js[..chunk.len()].copy_from_slice(chunk);
-                    bracket_neighbours(ps, i, &js, chunk.len(), sim_box, black_box(now), &mut lo, &mut hi);
+                    let mut lanes = Lanes::default();
+                    bracket_neighbours(ps, i, &js, chunk.len(), sim_box, black_box(now), &mut lo, &mut hi, &mut lanes);
                     n += hi[0];
                 }
             }

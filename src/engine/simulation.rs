@@ -19,7 +19,7 @@
 
 use super::collision::{Impulse, Restitution};
 use super::events::{
-    LANES, PairBracket, Pending, PendingKind, SAMPLE_RANK, bracket_neighbours, bracket_pair, pair_positions,
+    LANES, Lanes, PairBracket, Pending, PendingKind, SAMPLE_RANK, bracket_neighbours, bracket_pair, pair_positions,
     predict_pair, predict_wall, resolve_pair_event, resolve_wall_event, short_axes,
 };
 use super::geometry::{Boundary, Particle, SimBox};
@@ -223,7 +223,7 @@ pub struct Simulation<const D: usize> {
     batch: bool,
     /// The brackets of one prediction's neighbours (scratch space, kept here so that no
     /// prediction spends time initializing a kilobyte of stack).
-    brackets: Brackets,
+    brackets: Brackets<D>,
     /// Prefetch the data of the next event while processing a collision (large N only).
     lookahead: bool,
 }
@@ -234,16 +234,17 @@ struct Ahead {
     partner: Option<usize>,
 }
 
-/// Lower and upper ends of the brackets of up to [`NEAR`] neighbours.
+/// Lower and upper ends of the brackets of up to [`NEAR`] neighbours, and their balls.
 #[derive(Clone, Debug)]
-struct Brackets {
+struct Brackets<const D: usize> {
     lo: [f64; NEAR],
     hi: [f64; NEAR],
+    lanes: [Lanes<D>; NEAR / LANES],
 }
 
-impl Default for Brackets {
+impl<const D: usize> Default for Brackets<D> {
     fn default() -> Self {
-        Brackets { lo: [f64::INFINITY; NEAR], hi: [f64::INFINITY; NEAR] }
+        Brackets { lo: [f64::INFINITY; NEAR], hi: [f64::INFINITY; NEAR], lanes: [Lanes::default(); NEAR / LANES] }
     }
 }
 
@@ -655,17 +656,19 @@ impl<const D: usize> Simulation<D> {
             // lanes past the neighbours give [+∞, +∞]), so that no loop below ends at a count
             // the branch predictor cannot know.
             let lanes = n_near.div_ceil(LANES) * LANES;
-            let Brackets { lo, hi } = &mut self.brackets;
+            let Brackets { lo, hi, lanes: balls } = &mut self.brackets;
             let mut bound = best.time;
             for start in (0..lanes).step_by(LANES) {
                 let chunk = start..start + LANES;
                 let js = near[chunk.clone()].try_into().expect("LANES wide");
                 let (lo, hi) = (&mut lo[chunk.clone()], &mut hi[chunk]);
                 let (lo, hi) = (lo.try_into().expect("LANES wide"), hi.try_into().expect("LANES wide"));
-                let earliest = bracket_neighbours(&self.particles, i, js, n_near - start, &self.sim_box, now, lo, hi);
+                let balls = &mut balls[start / LANES];
+                let earliest =
+                    bracket_neighbours(&self.particles, i, js, n_near - start, &self.sim_box, now, lo, hi, balls);
                 bound = bound.min(earliest);
             }
-            let (lo, hi) = (&*lo, &*hi);
+            let (lo, hi, balls) = (&*lo, &*hi, &*balls);
             // Pass 2: the candidates whose bracket reaches down to the bound — usually one.
             // A lower end equal to the bound may still tie and win, so it is kept. Where both
             // ends of the bracket round to the same absolute time, that is the event's time
@@ -688,7 +691,8 @@ impl<const D: usize> Simulation<D> {
                 let t = if lo == hi && lo < f64::INFINITY {
                     Some(lo)
                 } else {
-                    predict_pair(p, q, &self.sim_box, now, &self.short).map(|t| t.max(now))
+                    // The exact root, from the balls the brackets were built from.
+                    balls[k as usize / LANES].predict(k as usize % LANES, now)
                 };
                 if let Some(t) = t {
                     let kind = PendingKind::Pair { partner: j as u32, partner_events: q.events };
