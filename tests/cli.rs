@@ -89,3 +89,25 @@ fn check_verifies_the_reference_cases() {
     assert!(stdout.contains("agree with the exact answers"), "{stdout}");
     assert!(!stdout.contains("MISMATCH"));
 }
+
+/// The benchmark's neighbourhood can be forced; a name that is not one is refused with the
+/// names allowed, before anything runs or is written.
+#[test]
+fn bench_takes_a_neighbourhood_and_refuses_unknown_ones() {
+    let out = collide(
+        &["bench-point", "--n", "500", "--eta", "0.65", "--warmup", "1", "--timed", "2000", "--neighbourhood", "grid"],
+        "",
+    );
+    assert!(out.status.success(), "{}", text(&out.stderr));
+    let point: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    assert_eq!((point["neighbourhood"].as_str(), point["lists"].as_bool()), (Some("grid"), Some(false)));
+    let out = collide(&["bench-point", "--n", "500", "--eta", "0.65", "--warmup", "1", "--timed", "2000"], "");
+    let point: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    assert_eq!((point["neighbourhood"].as_str(), point["lists"].as_bool()), (Some("auto"), Some(true)));
+    let dir = std::env::temp_dir().join(format!("collide-bench-refused-{}", std::process::id()));
+    let out = collide(&["bench", "--quick", "--neighbourhood", "list", "--out", dir.to_str().unwrap()], "");
+    assert!(!out.status.success());
+    let err = text(&out.stderr);
+    assert!(err.contains("\"list\"") && err.contains("auto, grid, lists"), "{err}");
+    assert!(!dir.exists(), "nothing is written for a refused command");
+}
