@@ -19,7 +19,9 @@
 //! Measured (alternating runs on one core, `benches/compare.sh`, η = 0.65, medians of 10, 6,
 //! 4 and 2 runs, 10⁶ collisions/s, tree → calendar): 1.50 → 1.60 at N = 10⁴ (callgrind, the
 //! `x86-64-v3` build: 6 178 → 5 463 instructions per collision), 2.06 → 2.18 at 10³, 0.91 →
-//! 0.93 at 10⁵, and 0.85, 0.90 → 0.70, 0.64 at 10⁶.
+//! 0.93 at 10⁵, and 0.85, 0.90 → 0.70, 0.64 at 10⁶; later, with the lookahead on for both
+//! (medians of 4): 1.015 → 1.034 at 10⁵ (within the noise) and 0.816 → 0.694 at 3·10⁵. So
+//! the calendar stops where the lookahead starts.
 
 use super::events::{Pending, PendingKind};
 
