@@ -5,9 +5,9 @@
 //! * [`geometry`]: [`Particle`], [`SimBox`], [`Boundary`], minimum image.
 //! * [`collision`]: the velocity update and the [`Impulse`] it reports.
 //! * [`events`]: event types, their total order, the pure predictions.
-//! * [`cells`]: the cell grid (of neighbour-list centres).
-//! * [`neighbours`]: neighbour lists with a skin.
-//! * [`queue`]: one pending event per particle, in a tournament tree.
+//! * [`cells`]: the cell grid (following the particles, or of neighbour-list centres).
+//! * [`neighbours`]: the grid that follows the particles, or neighbour lists with a skin.
+//! * [`queue`]: one pending event per particle, in a calendar of time buckets or a tournament tree.
 //! * `prefetch`: the cache hint of the lookahead (the crate's one `unsafe` block).
 //! * [`simulation`]: the event loop.
 //! * [`reference`]: the O(N²) reference.

@@ -1,10 +1,11 @@
 //! The event loop: one [`Simulation`] owns the particles, the event queue, the cell grid,
 //! the box and the clock.
 //!
-//! Each particle has exactly one pending event — the earliest of its collisions with the
-//! particles on its neighbour list, its next wall and the moment it leaves its skin (when
-//! its list is rebuilt; [`Neighbours`]) — held in a
-//! 4-ary tournament tree ([`EventQueue`]). `step()` takes the earliest; a pair event whose partner
+//! Each particle has exactly one pending event — the earliest of its collisions with its
+//! neighbours (on its list, or in the cells around it), its next wall and its next
+//! neighbourhood update (leaving its skin or its cell; [`Neighbours`]) — held in the
+//! [`EventQueue`] (a calendar of time buckets, or from 3·2¹⁴ particles a tournament tree).
+//! `step()` takes the earliest; a pair event whose partner
 //! has changed velocity since it was predicted (per-particle event counters) is a
 //! re-prediction marker: its owner is predicted again and nothing happens. Otherwise the
 //! particles involved are advanced to the event time, the event is resolved, they are
