@@ -212,7 +212,7 @@ impl Calendar {
 
     /// The owner of the earliest event, and the event. Moves the cursor past empty buckets
     /// (hence `&mut`). Chooses the bucket width again every `4N` searches, and as soon as
-    /// the searches of the last [`CHECK_EVERY`] visited more than [`MOST_WORK`] entries and
+    /// the searches of the last `CHECK_EVERY` visited more than `MOST_WORK` entries and
     /// empty buckets each on average (a width chosen for other events: at the start, or
     /// after the temperature changed).
     #[inline]
