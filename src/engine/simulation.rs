@@ -787,6 +787,12 @@ impl<const D: usize> Simulation<D> {
                     self.counts.pair += 1;
                     let (i, j) = if owner < partner { (owner, partner) } else { (partner, owner) };
                     let next = self.lookahead.then(|| self.prefetch_next(i, j));
+                    if !self.lookahead {
+                        // The partners' rows (or cell coordinates), read right after the
+                        // collision is resolved; with the lookahead they are on their way.
+                        self.neighbours.prefetch_first(i);
+                        self.neighbours.prefetch_first(j);
+                    }
                     let impulse = resolve_pair_event(&mut self.particles, i, j, &self.sim_box, t, self.restitution);
                     if self.particles[i].events == 0 || self.particles[j].events == 0 {
                         self.predict_everyone();
