@@ -21,7 +21,10 @@
 //! `x86-64-v3` build: 6 178 → 5 463 instructions per collision), 2.06 → 2.18 at 10³, 0.91 →
 //! 0.93 at 10⁵, and 0.85, 0.90 → 0.70, 0.64 at 10⁶; later, with the lookahead on for both
 //! (medians of 4): 1.015 → 1.034 at 10⁵ (within the noise) and 0.816 → 0.694 at 3·10⁵. So
-//! the calendar stops where the lookahead starts.
+//! the calendar stops where the lookahead starts. In the criterion bench
+//! `engine/parts/queue_set_first/{tree,calendar}` (10⁴ events, the earliest moved later by a
+//! uniform step: times spread evenly, unlike an engine's, which crowd at the front) both take
+//! about 44 ns per search and update (one run each, 44.4 and 43.3 ns).
 
 use super::events::{Pending, PendingKind};
 

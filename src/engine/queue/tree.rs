@@ -10,9 +10,10 @@
 //! internal node keeps the time and owner of the earliest event below it, so replacing one
 //! particle's event walks one path of ⌈log₄ N⌉ nodes, comparing the four children of each
 //! node on it as two independent pairs. Against the binary tree it replaced, an update of
-//! the root's owner costs the same (63 ns in `engine/parts/queue_set_root`, three
-//! interleaved runs each), the tree takes a third of the memory (N/3 nodes instead of N),
-//! and the whole engine measured +5 % (median of five interleaved runs, within the noise).
+//! the root's owner costs the same (63 ns in `engine/parts/queue_set_root` — now
+//! `queue_set_first/tree` —, three interleaved runs each), the tree takes a third of the
+//! memory (N/3 nodes instead of N), and the whole engine measured +5 % (median of five
+//! interleaved runs, within the noise).
 //! The four children of a node share one cache line (see [`Tree`]): 16 bytes per
 //! particle for the events and about 5 for the nodes.
 //!
