@@ -136,11 +136,6 @@ pub fn predict_pair_within<const D: usize>(
     short: &[bool; D],
     horizon: f64,
 ) -> Option<f64> {
-    let absolute = |contact: Contact, t0: f64| match contact {
-        Contact::Never(_) => None,
-        Contact::Now => Some(t0),
-        Contact::At(dt) => Some(t0 + dt),
-    };
     if !short.iter().any(|&s| s) {
         let (a, b, t0) = pair_balls(pi, pj, sim_box, now);
         return absolute(contact_time_within(&a, &b, relative_horizon(horizon, t0))?, t0);
@@ -225,9 +220,7 @@ pub fn bracket_pair<const D: usize>(
     let (a, b, t0) = pair_balls(pi, pj, sim_box, now);
     match contact_bracket(&a, &b, relative_horizon(horizon, t0)) {
         Bracket::Beyond => PairBracket::Beyond,
-        Bracket::Known(Contact::Never(_)) => PairBracket::Known(None),
-        Bracket::Known(Contact::Now) => PairBracket::Known(Some(t0)),
-        Bracket::Known(Contact::At(dt)) => PairBracket::Known(Some(t0 + dt)),
+        Bracket::Known(contact) => PairBracket::Known(absolute(contact, t0)),
         Bracket::Between { lo, hi } => PairBracket::Between { lo: t0 + lo, hi: t0 + hi },
     }
 }
@@ -356,12 +349,17 @@ impl<const D: usize> Lanes<D> {
     /// (callgrind, N = 10⁴, η = 0.65).
     #[inline]
     pub fn predict(&self, k: usize, now: f64) -> Option<f64> {
-        let t0 = self.t0[k];
-        match contact_time_unchecked(&self.first.get(k), &self.second.get(k)) {
-            Contact::Never(_) => None,
-            Contact::Now => Some(t0.max(now)),
-            Contact::At(dt) => Some((t0 + dt).max(now)),
-        }
+        absolute(contact_time_unchecked(&self.first.get(k), &self.second.get(k)), self.t0[k]).map(|t| t.max(now))
+    }
+}
+
+/// A contact of a pair whose kernel time starts at `t0`, as an absolute time (`None`: never).
+#[inline(always)]
+fn absolute(contact: Contact, t0: f64) -> Option<f64> {
+    match contact {
+        Contact::Never(_) => None,
+        Contact::Now => Some(t0),
+        Contact::At(dt) => Some(t0 + dt),
     }
 }
 
