@@ -10,6 +10,7 @@ use super::geometry::{Boundary, Particle, SimBox, image_count, image_count_by_co
 use nalgebra::SVector;
 use quadratic::{
     Ball, BallLanes, Bracket, Contact, contact_bracket, contact_brackets, contact_time_unchecked, contact_time_within,
+    narrow_contact,
 };
 use serde::{Deserialize, Serialize};
 use std::cmp::Ordering;
@@ -350,6 +351,26 @@ impl<const D: usize> Lanes<D> {
     #[inline]
     pub fn predict(&self, k: usize, now: f64) -> Option<f64> {
         absolute(contact_time_unchecked(&self.first.get(k), &self.second.get(k)), self.t0[k]).map(|t| t.max(now))
+    }
+
+    /// [`predict`](Self::predict) for lane `k` when its bracket's ends `[lo, hi]` (absolute,
+    /// as [`bracket_neighbours`] leaves them) round to different times: [`narrow_contact`]
+    /// pins the kernel's time `t` to one of two adjacent doubles `x₁ < x₂`; when `t₀ ⊕ x₁` and
+    /// `t₀ ⊕ x₂` round to the same absolute time, that is `t₀ ⊕ t` (rounding is monotone),
+    /// and otherwise [`Narrowed::time`](quadratic::Narrowed::time) tells `t` itself. The same number as `predict`'s.
+    /// `None`: not settled (rarely), ask `predict`.
+    ///
+    /// A bracket is some tens of ulps of the contact time wide, and the clock's ulp, early in
+    /// a run, only some tens of the contact time's: 54 % of the candidates of the benchmark
+    /// (N = 10⁴, η = 0.65, 10⁶ collisions from t = 0) had bracket ends rounding apart, 1.1
+    /// double-double roots per collision (counted).
+    #[inline(never)]
+    pub fn pinned(&self, k: usize, lo: f64, hi: f64, now: f64) -> Option<f64> {
+        let t0 = self.t0[k];
+        let guess = (lo - t0) + 0.5 * (hi - lo);
+        let narrowed = narrow_contact(&self.first.get(k), &self.second.get(k), guess)?;
+        let (a, b) = ((t0 + narrowed.lo()).max(now), (t0 + narrowed.hi()).max(now));
+        if a == b { Some(a) } else { narrowed.time().map(|t| (t0 + t).max(now)) }
     }
 }
 

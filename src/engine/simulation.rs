@@ -691,11 +691,15 @@ impl<const D: usize> Simulation<D> {
                 marked &= marked - 1;
                 let (j, lo, hi) = (near[k] as usize, lo[k], hi[k]);
                 let q = &self.particles[j];
+                let lanes = &balls[k / LANES];
                 let t = if lo == hi && lo < f64::INFINITY {
                     Some(lo)
+                } else if let Some(t) = (hi < f64::INFINITY).then(|| lanes.pinned(k % LANES, lo, hi, now)).flatten() {
+                    // Pinned to two ulps, which round to one absolute time.
+                    Some(t)
                 } else {
                     // The exact root, from the balls the brackets were built from.
-                    balls[k / LANES].predict(k % LANES, now)
+                    lanes.predict(k % LANES, now)
                 };
                 if let Some(t) = t {
                     let kind = PendingKind::Pair { partner: j as u32, partner_events: q.events };

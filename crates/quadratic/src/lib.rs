@@ -51,7 +51,7 @@ pub mod textbook;
 #[doc(hidden)]
 pub use contact::contact_time_exact_path;
 pub use contact::{
-    Ball, BallLanes, Bracket, Contact, ContactError, Field, Miss, contact_bracket, contact_brackets, contact_time,
-    contact_time_unchecked, contact_time_within,
+    Ball, BallLanes, Bracket, Contact, ContactError, Field, Miss, Narrowed, contact_bracket, contact_brackets,
+    contact_time, contact_time_unchecked, contact_time_within, narrow_contact,
 };
 pub use roots::{Coefficient, Roots, SolveError, solve};

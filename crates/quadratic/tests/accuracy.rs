@@ -340,3 +340,80 @@ fn brackets_are_tight_near_contact() {
     assert!(worst <= 160.0, "widest bracket {worst:.1} u·t");
     assert!(worst > 20.0, "suspiciously narrow: {worst:.1} u·t");
 }
+
+/// `narrow_contact` may only return `Some(n)` when `contact_time` gives `At(t)` with `t` equal
+/// to `n.lo()` or `n.hi()`, adjacent doubles, and the exact root strictly between them — for
+/// any guess: the answer itself, a few and a thousand ulps off, the middle of the bracket, far
+/// off, and nonsense (0, −1, ∞, NaN). For everything else (never, now) it must say `None`.
+/// `n.time()`, when it answers, must be `t` to the bit. On the dense-fluid family, from the
+/// middle of the bracket (the engine's guess), both must also be useful: they answer for
+/// nearly every contact (so a version that says `None` to stay safe fails here).
+fn narrow_contract<const D: usize>(families: Vec<(&'static str, BoxedStrategy<(Ball<D>, Ball<D>)>)>) {
+    use common::families::nudge;
+    for (name, strategy) in families {
+        let (contacts, pinned) = (RefCell::new(0usize), RefCell::new(0usize));
+        let result = runner(CASES / 4).run(&strategy, |(p, q)| {
+            let got = quadratic::contact_time(&p, &q).expect("valid inputs");
+            let exact = exact_contact(&p, &q);
+            let t = got.time().unwrap_or(1.0);
+            let middle = match quadratic::contact_bracket(&p, &q, f64::INFINITY) {
+                Bracket::Between { lo, hi } => Some(lo + 0.5 * (hi - lo)),
+                _ => None,
+            };
+            let guesses = [
+                t,
+                nudge(t, -3),
+                nudge(t, 3),
+                nudge(t, -1000),
+                nudge(t, 1000),
+                middle.unwrap_or(t),
+                0.5 * t,
+                4.0 * t,
+                0.0,
+                -1.0,
+                f64::INFINITY,
+                f64::NAN,
+            ];
+            for (k, &guess) in guesses.iter().enumerate() {
+                let Some(narrowed) = quadratic::narrow_contact(&p, &q, guess) else {
+                    continue;
+                };
+                let (x1, x2) = (narrowed.lo(), narrowed.hi());
+                let Contact::At(t) = got else {
+                    return Err(TestCaseError::fail(format!("{p:?} {q:?}: narrowed to [{x1:e}, {x2:e}] for {got:?}")));
+                };
+                prop_assert!(x1 <= t && t <= x2, "{:?} {:?}: {:e} not in [{:e}, {:e}]", p, q, t, x1, x2);
+                prop_assert_eq!(x2, x1.next_up());
+                prop_assert!(exact.exceeds(x1) && !exact.exceeds(x2), "{:?} {:?}: exact root outside", p, q);
+                let exactly = narrowed.time();
+                if let Some(time) = exactly {
+                    prop_assert_eq!(time.to_bits(), t.to_bits(), "{:?} {:?}: pinned {:e}, kernel {:e}", p, q, time, t);
+                }
+                if k == 5 && middle.is_some() && exactly.is_some() {
+                    *pinned.borrow_mut() += 1;
+                }
+            }
+            if middle.is_some() {
+                *contacts.borrow_mut() += 1;
+            }
+            Ok(())
+        });
+        if let Err(e) = result {
+            panic!("family '{name}': {e}");
+        }
+        if name.contains("dense-fluid") {
+            let (c, p) = (contacts.into_inner(), pinned.into_inner());
+            assert!(c > 100 && p as f64 >= 0.99 * c as f64, "{name}: pinned {p} of {c} bracketed contacts");
+        }
+    }
+}
+
+#[test]
+fn narrowed_contacts_hold_the_answer_2d() {
+    narrow_contract(contact_families());
+}
+
+#[test]
+fn narrowed_contacts_hold_the_answer_3d() {
+    narrow_contract(contact_families_3d());
+}
