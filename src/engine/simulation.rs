@@ -859,20 +859,21 @@ impl<const D: usize> Simulation<D> {
     }
 }
 
-/// Whether prefetching the next event's data pays for finding it: from about 6 MB of
-/// engine state on. Finding the next event and issuing the prefetches costs about 1 900
-/// instructions per collision (callgrind, N = 10⁴, η = 0.65), which only memory misses
-/// repay. Alternating runs at η = 0.65 (`benches/compare.sh`, medians of 4–8 runs, 10⁶/s),
-/// with 64-byte records and 16-byte events, on against off: 1.24 vs 1.62 at N = 10⁴, 1.14
-/// vs 1.35 at 2·10⁴, 1.09 vs 1.19 at 3·10⁴, 1.06 vs 1.14 at 4·10⁴; 1.02 vs 0.92 at
-/// 5.5·10⁴ and 0.98 vs 0.85 at 7·10⁴. (With the 72-byte records before, the crossover
-/// was between 3·10⁴ and 4·10⁴.)
+/// Whether prefetching the next event's data pays for finding it: from about 3 MB of
+/// engine state on. Finding the next event and issuing the prefetches costs instructions
+/// (about 1 900 per collision with the tree, callgrind, N = 10⁴, η = 0.65), which only
+/// memory misses repay. Alternating runs at η = 0.65 (`benches/compare.sh`, medians of 6–10
+/// runs, 10⁶/s), on against off, since its second stage waits no more for the next event's
+/// list row (seventh session; lists and, below 3·2¹⁴, the calendar): 2.00 vs 2.20 at
+/// N = 10⁴; 1.66 vs 1.72 at 2·10⁴ (maxima 1.85 vs 1.79); 1.57 vs 1.45 at 3·10⁴; 1.15 vs 1.01
+/// at 4·10⁴. (In the fourth session, with a stalling second stage, the grid and the tree,
+/// the crossover was between 4·10⁴ and 5.5·10⁴.)
 fn lookahead_pays(n: usize) -> bool {
     n >= LOOKAHEAD_FROM
 }
 
-/// The fewest particles for which [`lookahead_pays`]: 3·2¹⁴.
-const LOOKAHEAD_FROM: usize = 3 << 14;
+/// The fewest particles for which [`lookahead_pays`]: 3·2¹³.
+const LOOKAHEAD_FROM: usize = 3 << 13;
 
 /// Checks particles and box; returns the largest contact distance (the cell "reach").
 fn validate<const D: usize>(particles: &[Particle<D>], sim_box: &SimBox<D>) -> Result<f64, SetupError> {
@@ -1102,10 +1103,6 @@ mod tests {
         assert!(wraps > 1000, "{wraps} wraps");
     }
 
-    /// The lookahead (on by default only from `LOOKAHEAD_FROM` particles) prefetches and
-    /// nothing else: with it forced on, a small system runs through the same events bit for
-    /// bit, with the grid and with lists, and the guess it prefetches for is usually the
-    /// next event.
     /// The two queue structures give the same run, bit for bit, with the grid and with
     /// lists (the calendar is chosen below 3·2¹⁴ particles, the tree from there on).
     #[test]
@@ -1125,6 +1122,10 @@ mod tests {
         }
     }
 
+    /// The lookahead (on by default only from `LOOKAHEAD_FROM` particles) prefetches and
+    /// nothing else: with it forced on, a small system runs through the same events bit for
+    /// bit, with the grid and with lists, and the guess it prefetches for is usually the
+    /// next event.
     #[test]
     fn lookahead_changes_nothing() {
         for neighbourhood in [Neighbourhood::Grid, Neighbourhood::Lists] {
