@@ -364,6 +364,7 @@ impl<const D: usize> Lanes<D> {
     /// a run, only some tens of the contact time's: 54 % of the candidates of the benchmark
     /// (N = 10⁴, η = 0.65, 10⁶ collisions from t = 0) had bracket ends rounding apart, 1.1
     /// double-double roots per collision (counted).
+    // Out of line, so that profiles show its cost (inlined, it measured the same).
     #[inline(never)]
     pub fn pinned(&self, k: usize, lo: f64, hi: f64, now: f64) -> Option<f64> {
         let t0 = self.t0[k];

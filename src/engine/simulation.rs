@@ -699,7 +699,7 @@ impl<const D: usize> Simulation<D> {
                 let t = if lo == hi && lo < f64::INFINITY {
                     Some(lo)
                 } else if let Some(t) = (hi < f64::INFINITY).then(|| lanes.pinned(k % LANES, lo, hi, now)).flatten() {
-                    // Pinned to two ulps, which round to one absolute time.
+                    // Pinned to one ulp, and settled (`Lanes::pinned`).
                     Some(t)
                 } else {
                     // The exact root, from the balls the brackets were built from.
