@@ -31,7 +31,7 @@
 //! With lists, the cell grid ([`Cells`]) holds each particle by its centre, so a particle
 //! changes cell only when it rebuilds, with no crossing events.
 
-use super::cells::{Cells, Coord};
+use super::cells::{Around, Cells, Coord};
 use super::geometry::{Boundary, Particle, SimBox};
 use super::prefetch::prefetch;
 use nalgebra::SVector;
@@ -540,6 +540,34 @@ impl<const D: usize> Neighbours<D> {
                 prefetch(&records[j as usize]);
             }
         }
+    }
+
+    /// The second stage for a particle `i` whose next event is leaving its skin, at `centre`
+    /// (with lists): the rows of its old neighbours (which it leaves) and the heads of the
+    /// cells around its new centre (which [`rebuild`](Self::rebuild) scans). Returns those
+    /// cells, for [`prefetch_rebuild_third`](Self::prefetch_rebuild_third); `None` without
+    /// lists.
+    #[inline]
+    pub fn prefetch_rebuild_second(&self, i: usize, centre: &SVector<f64, D>) -> Option<Around> {
+        if !self.listed {
+            return None;
+        }
+        let list = &self.lists[i];
+        if !list.crowded() {
+            for &j in list.0.iter().take_while(|&&j| j != NONE) {
+                prefetch(&self.lists[j as usize]);
+            }
+        }
+        let around = self.cells.around(&self.cells.locate(centre));
+        self.cells.prefetch_heads(&around);
+        Some(around)
+    }
+
+    /// The third stage of [`prefetch_rebuild_second`](Self::prefetch_rebuild_second): the
+    /// first member of each of those cells, its link and its centre.
+    #[inline]
+    pub fn prefetch_rebuild_third(&self, around: &Around) {
+        self.cells.prefetch_members(around, &self.centres);
     }
 
     /// The third stage, for the grid (the heads should have arrived): the first member of

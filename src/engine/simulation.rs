@@ -24,6 +24,7 @@ use super::events::{
     predict_pair, predict_wall, resolve_pair_event, resolve_wall_event, short_axes,
 };
 use super::geometry::{Boundary, Particle, SimBox};
+use super::cells::Around;
 use super::neighbours::{Neighbourhood, Neighbours, Saved};
 use super::prefetch::prefetch;
 use super::queue::{EventQueue, QueueKind};
@@ -233,6 +234,8 @@ pub struct Simulation<const D: usize> {
 struct Ahead {
     next: usize,
     partner: Option<usize>,
+    /// The cells a rebuild of `next` will scan (its event is leaving its skin).
+    rebuild: Option<Around>,
 }
 
 /// Lower and upper ends of the brackets of up to [`NEAR`] neighbours, and their balls.
@@ -618,13 +621,21 @@ impl<const D: usize> Simulation<D> {
     fn prefetch_neighbourhood(&self, next: usize) -> Ahead {
         self.neighbours.prefetch_second(next, &self.particles);
         self.queue.prefetch_path(next);
-        let mut ahead = Ahead { next, partner: None };
-        if let PendingKind::Pair { partner, .. } = self.queue.get(next).kind {
-            let partner = partner as usize;
-            prefetch(&self.particles[partner]);
-            self.neighbours.prefetch_first(partner);
-            self.queue.prefetch_path(partner);
-            ahead.partner = Some(partner);
+        let mut ahead = Ahead { next, partner: None, rebuild: None };
+        let event = self.queue.get(next);
+        match event.kind {
+            PendingKind::Pair { partner, .. } => {
+                let partner = partner as usize;
+                prefetch(&self.particles[partner]);
+                self.neighbours.prefetch_first(partner);
+                self.queue.prefetch_path(partner);
+                ahead.partner = Some(partner);
+            }
+            PendingKind::Rebuild => {
+                let centre = self.particles[next].position_at(event.time);
+                ahead.rebuild = self.neighbours.prefetch_rebuild_second(next, &centre);
+            }
+            _ => {}
         }
         ahead
     }
@@ -634,6 +645,9 @@ impl<const D: usize> Simulation<D> {
         self.neighbours.prefetch_third(ahead.next, &self.particles);
         if let Some(partner) = ahead.partner {
             self.neighbours.prefetch_second(partner, &self.particles);
+        }
+        if let Some(around) = &ahead.rebuild {
+            self.neighbours.prefetch_rebuild_third(around);
         }
     }
 
