@@ -13,11 +13,16 @@
 //! every neighbour before it evaluates exactly the one or two pairs that can come first,
 //! `brackets-8` the same intervals from the branch-free batch kernel
 //! `quadratic::contact_brackets`, eight pairs per call (what the engine runs).
+//! * `contact/pin`: the contacts among the realistic pairs; `narrow` is
+//!   `quadratic::narrow_contact` from the middle of each bracket (one ulp), `narrow-and-time`
+//!   also settles which of the two doubles (what the engine does when a bracket's ends round
+//!   to two absolute times), `robust` the exact root it replaces.
 //! Reported per batch; divide by the batch size (printed as throughput) for the cost per call.
 
 use criterion::{Criterion, Throughput, criterion_group, criterion_main};
 use quadratic::{
-    Ball, BallLanes, Bracket, contact_bracket, contact_brackets, contact_time, contact_time_exact_path, solve, textbook,
+    Ball, BallLanes, Bracket, contact_bracket, contact_brackets, contact_time, contact_time_exact_path, narrow_contact,
+    solve, textbook,
 };
 use rand::rngs::Xoshiro256PlusPlus;
 use rand::{RngExt, SeedableRng};
@@ -152,6 +157,46 @@ fn contact(c: &mut Criterion) {
         });
         group.finish();
     }
+    // What the engine does with a candidate whose bracket's ends round to two absolute times:
+    // the contacts among the realistic pairs, pinned to one ulp from the middle of their
+    // brackets (and settled exactly), against the exact root.
+    let contacts: Vec<(Ball<2>, Ball<2>, f64)> = realistic
+        .iter()
+        .filter_map(|(p, q)| match contact_bracket(p, q, f64::INFINITY) {
+            Bracket::Between { lo, hi } => Some((*p, *q, lo + 0.5 * (hi - lo))),
+            _ => None,
+        })
+        .collect();
+    let mut group = c.benchmark_group("contact/pin");
+    group.throughput(Throughput::Elements(contacts.len() as u64));
+    group.bench_function("narrow", |b| {
+        b.iter(|| {
+            let mut n = 0.0;
+            for (p, q, guess) in &contacts {
+                n += narrow_contact(black_box(p), black_box(q), *guess).map_or(-1.0, |n| n.lo());
+            }
+            n
+        })
+    });
+    group.bench_function("narrow-and-time", |b| {
+        b.iter(|| {
+            let mut n = 0.0;
+            for (p, q, guess) in &contacts {
+                n += narrow_contact(black_box(p), black_box(q), *guess).and_then(|n| n.time()).unwrap_or(-1.0);
+            }
+            n
+        })
+    });
+    group.bench_function("robust", |b| {
+        b.iter(|| {
+            let mut n = 0.0;
+            for (p, q, _) in &contacts {
+                n += contact_time(black_box(p), black_box(q)).unwrap().time().unwrap_or(-1.0);
+            }
+            n
+        })
+    });
+    group.finish();
 }
 
 fn roots(c: &mut Criterion) {

@@ -18,13 +18,13 @@
 //! the pair's contact and coming up re-covers it. The brute-force
 //! [`ReferenceSimulation`](super::ReferenceSimulation) checks this bit for bit.
 
+use super::cells::Around;
 use super::collision::{Impulse, Restitution};
 use super::events::{
     LANES, Lanes, PairBracket, Pending, PendingKind, SAMPLE_RANK, bracket_neighbours, bracket_pair, pair_positions,
     predict_pair, predict_wall, resolve_pair_event, resolve_wall_event, short_axes,
 };
 use super::geometry::{Boundary, Particle, SimBox};
-use super::cells::Around;
 use super::neighbours::{Neighbourhood, Neighbours, Saved};
 use super::prefetch::prefetch;
 use super::queue::{EventQueue, QueueKind};

@@ -14,6 +14,9 @@
 //!   filter alone, so that only the one or two candidates that can come first pay for the
 //!   double-double root. [`contact_brackets`] does the same for a batch of pairs held in
 //!   [`BallLanes`] (structure of arrays), branch-free, so that the pairs share vector registers.
+//! * [`narrow_contact`] pins a contact time to two adjacent doubles from a guess (one
+//!   compensated, certified evaluation of the gap function), and [`Narrowed::time`] tells
+//!   which — for a caller that needs `t₀ + t` exactly when a bracket leaves two candidates.
 //! * [`exact`] holds the error-free building blocks (TwoSum, FMA TwoProd, Shewchuk
 //!   expansions, double-double); [`hex`] reads and writes C99 hex floats; [`textbook`]
 //!   is the seed's naive formula, kept only for comparison.
