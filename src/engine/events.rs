@@ -357,8 +357,8 @@ impl<const D: usize> Lanes<D> {
     /// as [`bracket_neighbours`] leaves them) round to different times: [`narrow_contact`]
     /// pins the kernel's time `t` to one of two adjacent doubles `x₁ < x₂`; when `t₀ ⊕ x₁` and
     /// `t₀ ⊕ x₂` round to the same absolute time, that is `t₀ ⊕ t` (rounding is monotone),
-    /// and otherwise [`Narrowed::time`](quadratic::Narrowed::time) tells `t` itself. The same number as `predict`'s.
-    /// `None`: not settled (rarely), ask `predict`.
+    /// and otherwise [`Narrowed::time`](quadratic::Narrowed::time) tells `t` itself. The same
+    /// number as `predict`'s; `None`: not settled (rarely), ask `predict`.
     ///
     /// A bracket is some tens of ulps of the contact time wide, and the clock's ulp, early in
     /// a run, only some tens of the contact time's: 54 % of the candidates of the benchmark

@@ -569,7 +569,7 @@ impl<const D: usize> Narrowed<D> {
     /// cases for ordinary pairs, where `ΣMᵢ|pᵢ|` is about `|F′|·lo/2`.
     pub fn time(&self) -> Option<f64> {
         // The midpoint lo + ulp/2, exactly, as a double-double.
-        let (lo, hi) = (self.lo, self.lo.next_up());
+        let (lo, hi) = (self.lo, self.hi());
         let half = 0.5 * (hi - lo);
         let at_midpoint = gap_at(&self.dr, &self.dv, self.sigma, (lo, half));
         let margin = pow2(-64) * at_midpoint.reach;
