@@ -148,14 +148,23 @@ fn unequal_masses_head_on_follow_the_1d_formula() {
 /// Dense lattice starts (many simultaneous near-contacts, "now" events, several cells per
 /// axis) through the same comparison with the reference, with the grid that follows the
 /// particles (the automatic choice at η = 0.7 would keep lists, tested below).
+/// The dense lattice starts of the reference comparisons, `count` disks each: a triangular
+/// lattice at η = 0.70 in a periodic box and a square one at η = 0.60 between walls.
+fn dense_lattices(count: usize) -> Vec<(Placement, Vec<Particle<2>>, SimBox<2>)> {
+    [(Placement::Triangular, 0.70, [Boundary::Periodic; 2]), (Placement::Square, 0.60, [Boundary::Wall; 2])]
+        .into_iter()
+        .map(|(placement, eta, boundary)| {
+            let species = vec![Species { count, radius: 0.5, mass: 1.0 }];
+            let sim_box = box_for_packing_fraction(&species, eta, boundary, placement, 1.0);
+            let particles = initial_particles(&species, &sim_box, placement, Velocities::Maxwell, 1.0, 9).unwrap();
+            (placement, particles, sim_box)
+        })
+        .collect()
+}
+
 #[test]
 fn fast_engine_matches_the_reference_from_dense_lattices() {
-    for (placement, eta, boundary) in
-        [(Placement::Triangular, 0.70, [Boundary::Periodic; 2]), (Placement::Square, 0.60, [Boundary::Wall; 2])]
-    {
-        let species = vec![Species { count: 64, radius: 0.5, mass: 1.0 }];
-        let sim_box = box_for_packing_fraction(&species, eta, boundary, placement, 1.0);
-        let particles = initial_particles(&species, &sim_box, placement, Velocities::Maxwell, 1.0, 9).unwrap();
+    for (placement, particles, sim_box) in dense_lattices(64) {
         let fast = Simulation::with_neighbourhood(particles.clone(), sim_box, Neighbourhood::Grid).unwrap();
         assert!(!fast.lists() && fast.cell_counts().iter().all(|&n| n >= 4), "{:?}", fast.cell_counts());
         let slow = ReferenceSimulation::new(particles, sim_box);
@@ -182,12 +191,7 @@ fn fast_engine_with_lists_matches_the_reference() {
             assert_same_collisions(fast, slow, 3000, &format!("lists, case {case}, seed {seed}"));
         }
     }
-    for (placement, eta, boundary) in
-        [(Placement::Triangular, 0.70, [Boundary::Periodic; 2]), (Placement::Square, 0.60, [Boundary::Wall; 2])]
-    {
-        let species = vec![Species { count: 100, radius: 0.5, mass: 1.0 }];
-        let sim_box = box_for_packing_fraction(&species, eta, boundary, placement, 1.0);
-        let particles = initial_particles(&species, &sim_box, placement, Velocities::Maxwell, 1.0, 9).unwrap();
+    for (placement, particles, sim_box) in dense_lattices(100) {
         let fast = Simulation::with_neighbourhood(particles.clone(), sim_box, Neighbourhood::Lists).unwrap();
         assert!(fast.lists());
         let slow = ReferenceSimulation::new(particles, sim_box);
