@@ -6,6 +6,10 @@
 //! * `contact/hard`: near-contact gaps of a few ulps, grazing at 10⁶σ, neighbours at 10⁹.
 //! * `roots/realistic` and `roots/hard`: random moderate coefficients; near-double roots and
 //!   extreme scales.
+//! * `contact/pin`: the contacts among the realistic pairs; `narrow` is
+//!   `quadratic::narrow_contact` from the middle of each bracket (one ulp), `narrow-and-time`
+//!   also settles which of the two doubles (what the engine does when a bracket's ends round
+//!   to two absolute times), `robust` the exact root it replaces.
 //!
 //! `robust` is `quadratic::contact_time` / `quadratic::solve`, `textbook` the seed's formula,
 //! `exact-path` the expansion fallback alone (what every pair would cost without the filter),
@@ -13,10 +17,7 @@
 //! every neighbour before it evaluates exactly the one or two pairs that can come first,
 //! `brackets-8` the same intervals from the branch-free batch kernel
 //! `quadratic::contact_brackets`, eight pairs per call (what the engine runs).
-//! * `contact/pin`: the contacts among the realistic pairs; `narrow` is
-//!   `quadratic::narrow_contact` from the middle of each bracket (one ulp), `narrow-and-time`
-//!   also settles which of the two doubles (what the engine does when a bracket's ends round
-//!   to two absolute times), `robust` the exact root it replaces.
+//!
 //! Reported per batch; divide by the batch size (printed as throughput) for the cost per call.
 
 use criterion::{Criterion, Throughput, criterion_group, criterion_main};
