@@ -2,7 +2,7 @@
 # Compare two builds of collide on this noisy, shared machine: alternate them, one run at a
 # time on one core, and report the median and maximum collisions per second of each.
 #
-#   bash benches/compare.sh BIN_A BIN_B [ROUNDS=8] [N=10000] [TIMED=1000000] [WARMUP=2] [ETA=0.65]
+#   bash benches/compare.sh BIN_A BIN_B [ROUNDS=8] [N=10000] [TIMED=1000000] [WARMUP=20] [ETA=0.65]
 #
 # BIN_A and BIN_B are collide binaries (copy target/release/collide aside before rebuilding).
 # A single pair of runs proves nothing under about 30 % here; eight rounds resolve about 5 %.
@@ -11,7 +11,7 @@ if [ $# -lt 2 ]; then
   sed -n '2,8p' "$0" | sed 's/^# \{0,1\}//'
   exit 2
 fi
-a=$1 b=$2 rounds=${3:-8} n=${4:-10000} timed=${5:-1000000} warmup=${6:-2} eta=${7:-0.65}
+a=$1 b=$2 rounds=${3:-8} n=${4:-10000} timed=${5:-1000000} warmup=${6:-20} eta=${7:-0.65}
 for bin in "$a" "$b"; do
   [ -x "$bin" ] || { echo "compare.sh: $bin is not an executable collide binary" >&2; exit 2; }
 done

@@ -27,8 +27,8 @@ fn warmed_up(n: usize, eta: f64) -> Simulation<2> {
     let sim_box = box_for_packing_fraction(&species, eta, [Boundary::Periodic; 2], Placement::Triangular, 1.0);
     let particles = initial_particles(&species, &sim_box, Placement::Triangular, Velocities::Maxwell, 1.0, 1).unwrap();
     let mut sim = Simulation::new(particles, sim_box).unwrap();
-    // Two collisions per particle: the lattice melts and the queue reaches its working size.
-    while sim.counts().pair < 2 * n as u64 {
+    // As `collide bench` does: the lattice relaxes (see `collide::lab::bench::WARMUP`).
+    while sim.counts().pair < collide::lab::bench::WARMUP * n as u64 {
         sim.step().unwrap();
     }
     sim

@@ -39,8 +39,9 @@
 //! assert_eq!(b.velocity, vector![1.0, 0.0]);
 //! assert_eq!(impulse.virial(), 2.0); // σ·|Δp| with σ = 1, |Δp| = 2
 //! ```
-// Denied, not forbidden: the one exception is the cache hint in `engine/prefetch.rs` (a
-// prefetch never faults and changes no state, but Rust's intrinsic takes a raw pointer).
+// Denied, not forbidden: the two exceptions are the cache hint in `engine/prefetch.rs` (a
+// prefetch never faults and changes no state, but Rust's intrinsic takes a raw pointer) and
+// the request for huge pages in `engine/pages.rs` (it changes no contents either).
 #![deny(unsafe_code)]
 #![warn(missing_docs)]
 

@@ -12,6 +12,7 @@
 //!   skin. No coordinate is stored: [`Cells::locate`] finds it from the centre.
 
 use super::geometry::{Boundary, SimBox};
+use super::pages;
 use nalgebra::SVector;
 
 /// No particle / end of a cell list.
@@ -171,7 +172,7 @@ impl<const D: usize> Cells<D> {
 
     fn with_coords(mut self, mut coords: Vec<[i64; D]>) -> Self {
         coords.shrink_to_fit();
-        self.next = vec![NONE; coords.len() + 1];
+        self.next = pages::filled(coords.len() + 1, NONE);
         self.wrapped = coords.iter().map(|m| self.wrap_axes(m)).collect();
         self.coords = coords;
         for i in 0..self.coords.len() {

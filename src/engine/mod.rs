@@ -8,7 +8,8 @@
 //! * [`cells`]: the cell grid (following the particles, or of neighbour-list centres).
 //! * [`neighbours`]: the grid that follows the particles, or neighbour lists with a skin.
 //! * [`queue`]: one pending event per particle, in a calendar of time buckets or a tournament tree.
-//! * `prefetch`: the cache hint of the lookahead (the crate's one `unsafe` block).
+//! * [`pages`]: huge pages for the large arrays (with `prefetch`, the crate's only `unsafe` code).
+//! * `prefetch`: the cache hint of the lookahead.
 //! * [`simulation`]: the event loop.
 //! * [`reference`]: the O(N²) reference.
 //! * [`init`]: initial states (lattices, random placement, Maxwell or fixed-speed velocities).
@@ -19,6 +20,7 @@ pub mod events;
 pub mod geometry;
 pub mod init;
 pub mod neighbours;
+pub mod pages;
 mod prefetch;
 pub mod queue;
 pub mod reference;

@@ -33,6 +33,7 @@
 
 use super::cells::{Around, Cells, Coord};
 use super::geometry::{Boundary, Particle, SimBox};
+use super::pages;
 use super::prefetch::prefetch;
 use nalgebra::SVector;
 use serde::{Deserialize, Serialize};
@@ -297,22 +298,20 @@ impl<const D: usize> Neighbours<D> {
         let empty = |cells| Self::bare(sim_box, cells);
         match (skin, saved) {
             (None, Saved::Cells(coords)) if coords.len() == n => Ok(empty(Cells::from_coords(sim_box, reach, coords))),
-            (Some(skin), Saved::Centres(mut centres)) if centres.len() == n => {
+            (Some(skin), Saved::Centres(centres)) if centres.len() == n => {
                 let range = reach + skin;
                 let half = 0.5 * skin * (1.0 - f64::EPSILON * (1u64 << 32) as f64);
-                centres.shrink_to_fit();
+                let centres = pages::moved(centres);
                 let mut neighbours = empty(Cells::new(sim_box, range, centres.iter().copied()));
                 neighbours.centres = centres;
                 neighbours.listed = true;
                 neighbours.range2 = range * range;
                 neighbours.exit2 = half * half;
                 neighbours.bound2 = 0.25 * skin * skin;
-                neighbours.lists = (0..n)
-                    .map(|i| {
-                        neighbours.scan(i);
-                        List::from_members(&neighbours.scratch)
-                    })
-                    .collect();
+                neighbours.lists = pages::collect((0..n).map(|i| {
+                    neighbours.scan(i);
+                    List::from_members(&neighbours.scratch)
+                }));
                 Ok(neighbours)
             }
             (skin, _) => Err(format!(

@@ -26,6 +26,7 @@ use super::events::{
 };
 use super::geometry::{Boundary, Particle, SimBox};
 use super::neighbours::{Neighbourhood, Neighbours, Saved};
+use super::pages;
 use super::prefetch::prefetch;
 use super::queue::{EventQueue, QueueKind};
 use nalgebra::SVector;
@@ -291,12 +292,12 @@ impl<const D: usize> Simulation<D> {
     /// [`new`](Self::new) with the neighbourhood chosen: the events are the same whichever
     /// it is, bit for bit (only the bookkeeping events and the speed differ).
     pub fn with_neighbourhood(
-        mut particles: Vec<Particle<D>>,
+        particles: Vec<Particle<D>>,
         sim_box: SimBox<D>,
         neighbourhood: Neighbourhood,
     ) -> Result<Self, SetupError> {
         let reach = validate(&particles, &sim_box)?;
-        particles.shrink_to_fit();
+        let particles = pages::moved(particles);
         let time = particles.iter().map(|p| p.time).fold(f64::NEG_INFINITY, f64::max);
         let short = short_axes(&sim_box, reach);
         let neighbours = Neighbours::new(&sim_box, reach, &particles, time, !short.contains(&true), neighbourhood);
@@ -380,7 +381,7 @@ impl<const D: usize> Simulation<D> {
         Ok(Simulation {
             neighbours,
             neighbourhood: state.neighbourhood,
-            particles: state.particles,
+            particles: pages::moved(state.particles),
             batch: !short.contains(&true),
             brackets: Brackets::default(),
             lookahead: lookahead_pays(n),

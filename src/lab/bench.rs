@@ -47,6 +47,10 @@ pub struct BenchPoint {
     pub crowded_fraction: f64,
     /// Peak resident set size of the process, bytes (when known).
     pub peak_rss_bytes: Option<u64>,
+    /// The process's memory in 2 MB pages at the end, bytes (`AnonHugePages`, when known;
+    /// see `engine::pages`).
+    #[serde(default)]
+    pub huge_page_bytes: Option<u64>,
 }
 
 /// The process's peak resident set size (Linux `VmHWM`), if readable.
@@ -99,14 +103,29 @@ pub fn measure(
         engine_bytes_per_particle: sim.memory_bytes() as f64 / n as f64,
         crowded_fraction: sim.crowded() as f64 / n as f64,
         peak_rss_bytes: peak_rss_bytes(),
+        huge_page_bytes: crate::engine::pages::huge_page_bytes(),
     })
 }
+
+/// Untimed warm-up collisions per particle before a point is timed. The lattice relaxes
+/// slowly at η = 0.65: list rebuilds per collision, a measure of how far the disks wander,
+/// were 0.057, 0.074, 0.096, 0.107, 0.114 and 0.119 after 1, 2, 5, 8, 12 and 20 collisions
+/// per particle, and 0.117–0.124 from there to 160 (N = 10⁴, 2·10⁴–5·10⁴ collisions counted
+/// each; the same at N = 10⁵: 0.096 after 5, 0.119 after 20). Timed before that, large N
+/// measured the rattling lattice: at N = 10⁶, 0.98·10⁶ collisions/s after 1 per particle
+/// against 0.80·10⁶/s after 20 (one run each). At η = 0.3 the rate is steady from the first
+/// collision on (1.32–1.34 cell crossings per collision after 1 to 20).
+pub const WARMUP: u64 = 20;
 
 /// The matrix: (N, η) pairs, warm-up collisions per particle, timed collisions for N.
 pub fn matrix(quick: bool) -> (Vec<(usize, f64)>, u64, fn(usize) -> u64) {
     let sizes: &[usize] = if quick { &[1_000, 10_000] } else { &[1_000, 10_000, 100_000, 1_000_000] };
     let points = sizes.iter().flat_map(|&n| [0.3, 0.65].map(|eta| (n, eta))).collect();
-    if quick { (points, 2, |n| (2 * n as u64).max(200_000)) } else { (points, 5, |n| (5 * n as u64).max(2_000_000)) }
+    if quick {
+        (points, WARMUP, |n| (2 * n as u64).max(200_000))
+    } else {
+        (points, WARMUP, |n| (5 * n as u64).max(2_000_000))
+    }
 }
 
 /// Today's date (UTC) as YYYY-MM-DD, from the system clock (civil-from-days).

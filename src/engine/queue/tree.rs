@@ -22,6 +22,7 @@
 
 use super::Slot;
 use crate::engine::events::Pending;
+use crate::engine::pages;
 
 /// Children per internal node.
 const ARITY: usize = 4;
@@ -93,12 +94,12 @@ impl Tree {
         let shift = (m + ARITY - 1) % ARITY;
         let empty = Group([Slot::pack(Pending::NOTHING); ARITY]);
         let mut queue = Tree {
-            groups: vec![empty; (slots + shift).div_ceil(ARITY)],
+            groups: pages::filled((slots + shift).div_ceil(ARITY), empty),
             shift,
             n,
             m,
             root: NO_NODE,
-            quads: vec![Quad([NO_NODE; ARITY]); m.saturating_sub(1).div_ceil(ARITY)],
+            quads: pages::filled(m.saturating_sub(1).div_ceil(ARITY), Quad([NO_NODE; ARITY])),
         };
         // Built even though every time is +∞: the winners of those ties are decided by the
         // full key, as everywhere else.
