@@ -270,7 +270,7 @@ pub enum Bracket {
 ///
 /// `(c̃ − γ) / (−b̃ + β + √(D̃ + δ)) ≤ t ≤ (c̃ + γ) / (−b̃ − β + √(D̃ − δ))`
 ///
-/// widened by 16 u for the rounding of these expressions and the one ulp of the returned
+/// widened by 8u for the rounding of these expressions and the one ulp of the returned
 /// time. Typical pairs get a bracket some tens of ulps wide (it is the plain f64 `c`, whose
 /// error grows like u·(|Δr|² + σ²)/c near contact, that would make it hundreds) at the cost
 /// of one square root, two divisions and a dozen error-free operations; the double-double
@@ -843,9 +843,8 @@ fn filtered<const D: usize, const BRACKET: bool>(first: &Ball<D>, second: &Ball<
     }
     if BRACKET {
         // t = c/(−b + √D) with c ∈ [c̃ ∓ γ], −b ∈ [−b̃ ∓ β] (both > 0) and D ∈ [D̃ ∓ δ] (> 0):
-        // smallest numerator over largest denominator and vice versa. About eight roundings
-        // of at most u each (sqrt, sums, quotient), plus 1 ulp for the time actually returned:
-        // 16u on each side covers them, and MIN_POSITIVE any underflow. The signs above used
+        // smallest numerator over largest denominator and vice versa, widened for the
+        // roundings and the returned time's ulp (`bracket_ends`). The signs above used
         // the cheap `c̃`; the bracket takes the compensated one (`tight_c`), whose bound is
         // about 2u·c instead of 7u·(|Δr|² + σ²).
         let tight = tight_c(&first.position, &second.position, first.radius, second.radius);
@@ -1004,11 +1003,35 @@ fn filter_disc<const D: usize>(h: &[f64; D], g: &[f64; D], s: f64) -> (f64, f64,
 
 /// The certified bracket of `t = c/(−b + √D)` from the three values and their bounds, when
 /// `b < 0`, `c > 0`, `D > 0` are certified (see the bracket step of [`filtered`]).
+///
+/// With `c ∈ [c̃ ∓ γ]`, `−b ∈ [−b̃ ∓ β]` and `D ∈ [D̃ ∓ δ]`, the smallest numerator over the
+/// largest denominator is at most `t`, and the largest over the smallest at least `t`. Each
+/// end is computed with a relative error below 4.5u to first order: one rounding for the
+/// numerator, one for `D ± δ` (half of it through the square root) and one for the root, one
+/// for the sum of the denominator's two positive terms, one for the quotient. The time the
+/// kernel returns is within one ulp (at most 2u relatively) of `t`, and the widening itself
+/// rounds once more: [`WIDEN`]` = 8u` on each side covers the 7.5u, and MIN_POSITIVE any
+/// underflow. (The test `bracket_ends_hold_the_one_ulp_band` checks that 8u holds and that
+/// 5u does not.)
 #[inline(always)]
-fn bracket_ends((b, bound_b): (f64, f64), (c, bound_c): (f64, f64), (disc, bound_d): (f64, f64)) -> (f64, f64) {
+fn bracket_ends(b: (f64, f64), c: (f64, f64), disc: (f64, f64)) -> (f64, f64) {
+    widened_ends(b, c, disc, WIDEN)
+}
+
+/// The relative widening of [`bracket_ends`].
+const WIDEN: f64 = 8.0 * U;
+
+/// [`bracket_ends`] with the widening `widen` (relative, on each side).
+#[inline(always)]
+fn widened_ends(
+    (b, bound_b): (f64, f64),
+    (c, bound_c): (f64, f64),
+    (disc, bound_d): (f64, f64),
+    widen: f64,
+) -> (f64, f64) {
     let lo = (c - bound_c) / ((bound_b - b) + (disc + bound_d).sqrt());
     let hi = (c + bound_c) / ((-b - bound_b) + (disc - bound_d).sqrt());
-    ((lo * (1.0 - 16.0 * U) - f64::MIN_POSITIVE).max(0.0), hi * (1.0 + 16.0 * U) + f64::MIN_POSITIVE)
+    ((lo * (1.0 - widen) - f64::MIN_POSITIVE).max(0.0), hi * (1.0 + widen) + f64::MIN_POSITIVE)
 }
 
 /// A double-double accumulator: heads summed exactly by TwoSum, tails in plain f64.
@@ -1142,5 +1165,42 @@ mod tests {
         let q = ball([0.0, 0.0], [0.0, 0.0], -2.0);
         let p = ball([0.0, 0.0], [0.0, 0.0], 1.0);
         assert!(matches!(contact_time(&p, &q), Err(ContactError::NegativeRadius { ball: 2, .. })));
+    }
+
+    /// The widening of [`bracket_ends`] against its derivation: with exact values (zero
+    /// bounds), every bracket must hold the band `t·(1 ∓ 2u)` — one ulp either side of the
+    /// exact root `t`, where the kernel's time may lie — for `b`, `c`, `D` spread over twelve
+    /// decades and `D` down to 10⁻⁸·b² (glancing). The root is computed in double-double
+    /// (relative error ~2⁻¹⁰³, far inside the margins). With 8u this must hold everywhere;
+    /// with 5u it must fail somewhere (measured: about 400 of the 200 000 cases; 900 with 4u,
+    /// none from 6u on — the ends' roundings reach past 3u, their bound being 4.5u plus the
+    /// widening's own), so the test tells a widening too small from a sufficient one.
+    #[test]
+    fn bracket_ends_hold_the_one_ulp_band() {
+        let mut state = 0x2545_F491_4F6C_DD1Du64;
+        let mut unit = move || {
+            state ^= state >> 12;
+            state ^= state << 25;
+            state ^= state >> 27;
+            (state.wrapping_mul(0x2545_F491_4F6C_DD1D) >> 11) as f64 / (1u64 << 53) as f64
+        };
+        let misses = |widen: f64, unit: &mut dyn FnMut() -> f64| {
+            let mut missed = 0;
+            for _ in 0..200_000 {
+                let b = -(10f64.powf(12.0 * unit() - 6.0));
+                let c = 10f64.powf(12.0 * unit() - 6.0);
+                let disc = b * b * 10f64.powf(-8.0 * unit());
+                let (lo, hi) = widened_ends((b, 0.0), (c, 0.0), (disc, 0.0), widen);
+                let t = Dd::from_f64(c).div(Dd::from_f64(-b).add(Dd::from_f64(disc).sqrt()));
+                let below = t.mul(Dd::from_f64(1.0 - 2.0 * U));
+                let above = t.mul(Dd::from_f64(1.0 + 2.0 * U));
+                // lo ≤ below and hi ≥ above; the differences of nearby doubles are exact.
+                let holds = lo - below.hi <= below.lo && hi - above.hi >= above.lo;
+                missed += usize::from(!holds);
+            }
+            missed
+        };
+        assert_eq!(misses(WIDEN, &mut unit), 0, "the widening of bracket_ends misses the band");
+        assert!(misses(5.0 * U, &mut unit) > 0, "a widening of 5u should miss: the test has no teeth");
     }
 }

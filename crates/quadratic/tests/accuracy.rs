@@ -296,7 +296,7 @@ fn oracle_detects_wrong_answers() {
 /// at coordinates up to 100σ from the origin (so the differences of positions round). Over
 /// this family the bracket is at most `β`-, `δ`- and rounding-terms wide: `2β/(−b)` ≤ 24u
 /// (the angle keeps `Σ|hᵢgᵢ| ≤ 2|b|`), `δ/D` ≤ 64u (it keeps `D ≥ ¾|Δv|²σ²` near contact),
-/// 32u of margins, and the compensated `c`'s `2γ/c` ≈ 4u — about 130u in all, so 160u bounds
+/// 16u of margins, and the compensated `c`'s `2γ/c` ≈ 4u — about 115u in all, so 160u bounds
 /// it. A bracket computed with the plain f64 `c` (error ~7u·(|Δr|² + σ²)) would be wider than
 /// 160u for every gap below about 10⁻¹ (≈ 14u/gap from `γ` alone): this fails if the
 /// compensation is lost. Also checks that every bracket holds the contact time.
