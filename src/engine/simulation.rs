@@ -699,12 +699,15 @@ impl<const D: usize> Simulation<D> {
             // Which lanes are candidates is a coin toss for the branch predictor: they are
             // marked without branches first, one bit each (a branch per lane mispredicted
             // about twice per prediction; callgrind's branch simulation, N = 10⁴, η = 0.65),
-            // and the bits are visited lowest first.
+            // and the bits are visited lowest first. Only the neighbours' lanes count: the
+            // padding of the last chunk brackets to [+∞, +∞] too, which an infinite bound
+            // (nothing else pending, as for a disk at rest) would reach.
             const { assert!(NEAR <= 64) };
             let mut marked = 0u64;
             for (k, &lo) in lo[..lanes].iter().enumerate() {
                 marked |= ((lo <= bound) as u64) << k;
             }
+            marked &= if n_near < 64 { (1u64 << n_near) - 1 } else { u64::MAX };
             while marked != 0 {
                 let k = marked.trailing_zeros() as usize;
                 marked &= marked - 1;
@@ -994,6 +997,35 @@ mod tests {
             }
             assert_eq!(batch.particles(), scalar.particles());
             assert!(batch.counts().pair > 10_000, "{:?}", batch.counts());
+        }
+    }
+
+    /// A gas at rest has nothing to do: every prediction's bound is +∞, which the padding of
+    /// a chunk of lanes also brackets to; those lanes hold no neighbour and must not be taken
+    /// for candidates (they once were, and indexed the particles with a list's end marker).
+    /// With one disk moving, only its own collisions happen.
+    #[test]
+    fn a_gas_at_rest_stays_at_rest() {
+        for neighbourhood in [Neighbourhood::Grid, Neighbourhood::Lists] {
+            let moving = system(20, false, neighbourhood);
+            let still: Vec<Particle<2>> =
+                moving.particles.iter().map(|p| Particle { velocity: SVector::zeros(), ..p.clone() }).collect();
+            let mut sim = Simulation::with_neighbourhood(still.clone(), moving.sim_box, neighbourhood).expect("valid");
+            assert_eq!(sim.lists(), neighbourhood == Neighbourhood::Lists);
+            assert_eq!(sim.step(), None);
+            let mut one = still;
+            one[7].velocity = SVector::from([0.3, 0.1]);
+            let mut sim = Simulation::with_neighbourhood(one, moving.sim_box, neighbourhood).expect("valid");
+            let first = loop {
+                match sim.step() {
+                    Some(Outcome::Rebuild) => continue,
+                    other => break other,
+                }
+            };
+            match first {
+                Some(Outcome::Pair { i, j, .. }) => assert!(i == 7 || j == 7, "{i} {j}"),
+                other => panic!("{other:?}"),
+            }
         }
     }
 
