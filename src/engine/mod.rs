@@ -8,12 +8,14 @@
 //! * [`cells`]: the cell grid (following the particles, or of neighbour-list centres).
 //! * [`neighbours`]: the grid that follows the particles, or neighbour lists with a skin.
 //! * [`queue`]: one pending event per particle, in a calendar of time buckets or a tournament tree.
+//! * [`cache`]: the level-2 cache's size, which sets where the lookahead starts.
 //! * [`pages`]: huge pages for the large arrays (with `prefetch`, the crate's only `unsafe` code).
 //! * `prefetch`: the cache hint of the lookahead.
 //! * [`simulation`]: the event loop.
 //! * [`reference`]: the O(N²) reference.
 //! * [`init`]: initial states (lattices, random placement, Maxwell or fixed-speed velocities).
 
+pub mod cache;
 pub mod cells;
 pub mod collision;
 pub mod events;

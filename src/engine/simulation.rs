@@ -877,21 +877,29 @@ impl<const D: usize> Simulation<D> {
     }
 }
 
-/// Whether prefetching the next event's data pays for finding it: from about 3 MB of
-/// engine state on. Finding the next event and issuing the prefetches costs instructions
-/// (about 1 900 per collision with the tree, callgrind, N = 10⁴, η = 0.65), which only
-/// memory misses repay. Alternating runs at η = 0.65 (`benches/compare.sh`, medians of 6–10
-/// runs, 10⁶/s), on against off, since its second stage waits no more for the next event's
-/// list row (seventh session; lists and, below 3·2¹⁴, the calendar): 2.00 vs 2.20 at
-/// N = 10⁴; 1.66 vs 1.72 at 2·10⁴ (maxima 1.85 vs 1.79); 1.57 vs 1.45 at 3·10⁴; 1.15 vs 1.01
-/// at 4·10⁴. (In the fourth session, with a stalling second stage, the grid and the tree,
-/// the crossover was between 4·10⁴ and 5.5·10⁴.)
+/// Whether prefetching the next event's data pays for finding it: once the engine's state
+/// has left the level-2 cache, from [`lookahead_from`] particles on. Finding the next event
+/// and issuing the prefetches costs instructions (about 1 900 per collision with the tree,
+/// callgrind, N = 10⁴, η = 0.65), which only misses of that cache repay.
 fn lookahead_pays(n: usize) -> bool {
-    n >= LOOKAHEAD_FROM
+    n >= lookahead_from(super::cache::level2_bytes())
 }
 
-/// The fewest particles for which [`lookahead_pays`]: 3·2¹³.
-const LOOKAHEAD_FROM: usize = 3 << 13;
+/// The fewest particles for which the lookahead pays with a level-2 cache of `l2` bytes
+/// (1 MiB when unknown): 3·2¹³ per MiB, about 3.5 bytes of engine state per byte of cache.
+///
+/// Measured, alternating runs at η = 0.65 (`benches/compare.sh`, medians, 10⁶/s, on against
+/// off). On the AMD EPYC of the first nine sessions (1 MiB L2), with lists and, below
+/// 3·2¹⁴, the calendar, 6–10 runs: 2.00 vs 2.20 at N = 10⁴; 1.66 vs 1.72 at 2·10⁴; 1.57 vs
+/// 1.45 at 3·10⁴; 1.15 vs 1.01 at 4·10⁴ — the threshold was 3·2¹³ = 24 576 particles. On
+/// the Intel Xeon (Emerald Rapids, 2 MiB L2) of the tenth, 6 runs each: 1.085 vs 1.235 at
+/// 10⁴; 0.703 vs 0.813 at 3·10⁴; 0.595 vs 0.622 at 5·10⁴; 0.542 vs 0.532 at 7·10⁴; 0.665
+/// vs 0.633 at 10⁵ — the crossover doubled with the cache, to about 6·10⁴; this gives 49 152.
+fn lookahead_from(l2: Option<usize>) -> usize {
+    const PER_MIB: usize = 3 << 13;
+    let l2 = l2.unwrap_or(1 << 20);
+    (PER_MIB as u128 * l2 as u128 / (1 << 20) as u128).clamp(1, usize::MAX as u128) as usize
+}
 
 /// Checks particles and box; returns the largest contact distance (the cell "reach").
 fn validate<const D: usize>(particles: &[Particle<D>], sim_box: &SimBox<D>) -> Result<f64, SetupError> {
@@ -1169,7 +1177,19 @@ mod tests {
         }
     }
 
-    /// The lookahead (on by default only from `LOOKAHEAD_FROM` particles) prefetches and
+    /// The lookahead starts where the engine's state leaves the level-2 cache: at the
+    /// measured crossovers of both machines it ran on (see `lookahead_from`).
+    #[test]
+    fn the_lookahead_starts_with_the_cache() {
+        assert_eq!(lookahead_from(Some(1 << 20)), 3 << 13);
+        assert_eq!(lookahead_from(Some(2 << 20)), 3 << 14);
+        assert_eq!(lookahead_from(None), 3 << 13);
+        assert_eq!(lookahead_from(Some(256 << 10)), 3 << 11);
+        assert_eq!(lookahead_from(Some(1)), 1);
+        assert!(lookahead_from(Some(usize::MAX)) > 1 << 40);
+    }
+
+    /// The lookahead (on by default only from `lookahead_from` particles) prefetches and
     /// nothing else: with it forced on, a small system runs through the same events bit for
     /// bit, with the grid and with lists, and the guess it prefetches for is usually the
     /// next event.
