@@ -650,7 +650,7 @@ mod tests {
                 let i = rng.random_range(0..particles.len());
                 let angle = rng.random_range(0.0..std::f64::consts::TAU);
                 let speed = 2f64.powi(exponent) * rng.random_range(1.0..2.0);
-                // Half the components at the scale's binade, some far below it.
+                // Both components near the scale, or (one time in five) one far below it.
                 let (x, y) = (angle.cos(), angle.sin() * if rng.random_bool(0.2) { 1e-200 } else { 1.0 });
                 let velocity = SVector::from([x * speed, y * speed]);
                 if !velocity.iter().all(|v| v.is_finite()) || velocity == SVector::<f64, 2>::zeros() {
