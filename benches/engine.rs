@@ -3,6 +3,10 @@
 //! events until one more pair collision has happened, so criterion's throughput is in
 //! collisions per second.
 //!
+//! `engine/floor` times the hardware's floor (`collide::lab::floor`: two disks moved,
+//! bounced and re-predicted against eight fixed neighbours, no queue) at N = 10⁴ and 10⁵,
+//! η = 0.65, per collision: what the engine's rate is a fraction of.
+//!
 //! `engine/parts` times pieces of one collision's work at N = 10⁴, η = 0.65, to show where
 //! the time goes: `bracket_pair` over every pair of a warmed-up state closer than 1.8σ (per
 //! pair); `bracket_neighbours`, the batch version the engine runs, over every particle's
@@ -51,6 +55,19 @@ fn engine(c: &mut Criterion) {
                 })
             });
         }
+    }
+    group.finish();
+}
+
+/// The hardware's floor (`collide::lab::floor`) at η = 0.65: per collision, for the
+/// engine's rate as a fraction of it.
+fn floor(c: &mut Criterion) {
+    let mut group = c.benchmark_group("engine/floor");
+    group.throughput(Throughput::Elements(1));
+    for n in [10_000, 100_000] {
+        let mut floor = collide::lab::floor::Floor::new(n, 0.65, 1).unwrap();
+        let mut rng = Xoshiro256PlusPlus::seed_from_u64(2);
+        group.bench_function(BenchmarkId::new("eta=0.65", n), |b| b.iter(|| floor.collide(rng.random_range(0..n))));
     }
     group.finish();
 }
@@ -128,5 +145,5 @@ fn config() -> Criterion {
     Criterion::default().warm_up_time(Duration::from_secs(1)).measurement_time(Duration::from_secs(3)).sample_size(20)
 }
 
-criterion_group! { name = benches; config = config(); targets = engine, parts }
+criterion_group! { name = benches; config = config(); targets = engine, floor, parts }
 criterion_main!(benches);

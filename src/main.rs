@@ -54,6 +54,18 @@ enum Command {
         #[arg(long, default_value_t = Neighbourhood::Auto)]
         neighbourhood: Neighbourhood,
     },
+    /// The hardware's floor for one point, without and with its lookahead (JSON lines).
+    #[command(hide = true)]
+    BenchFloor {
+        #[arg(long)]
+        n: usize,
+        #[arg(long)]
+        eta: f64,
+        #[arg(long)]
+        timed: u64,
+        #[arg(long, default_value_t = 1)]
+        seed: u64,
+    },
     /// Checks the numerics on this machine against the built-in edge-case reference;
     /// exits non-zero on any mismatch.
     Check,
@@ -180,6 +192,14 @@ fn run(cli: Cli) -> Result<ExitCode> {
             let point =
                 collide::lab::bench::measure(n, eta, neighbourhood, warmup, timed, seed).map_err(anyhow::Error::msg)?;
             say!("{}", serde_json::to_string(&point)?);
+            Ok(ExitCode::SUCCESS)
+        }
+        Command::BenchFloor { n, eta, timed, seed } => {
+            for point in
+                collide::lab::floor::measure_both(n, eta, 2 * n as u64, timed, seed).map_err(anyhow::Error::msg)?
+            {
+                say!("{}", serde_json::to_string(&point)?);
+            }
             Ok(ExitCode::SUCCESS)
         }
         Command::Run(args) => run_simulation(args),

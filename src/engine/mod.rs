@@ -23,7 +23,7 @@ pub mod geometry;
 pub mod init;
 pub mod neighbours;
 pub mod pages;
-mod prefetch;
+pub(crate) mod prefetch;
 pub mod queue;
 pub mod reference;
 pub mod simulation;

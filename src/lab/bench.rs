@@ -51,6 +51,18 @@ pub struct BenchPoint {
     /// see `engine::pages`).
     #[serde(default)]
     pub huge_page_bytes: Option<u64>,
+    /// The hardware's floor for the same N and η on this machine ([`super::floor`]: move two
+    /// disks, bounce, re-predict both against eight fixed neighbours; no queue, no list
+    /// upkeep, no exact times), collisions per second — measured in the same process after
+    /// the engine, with as many timed collisions.
+    #[serde(default)]
+    pub floor_collisions_per_second: Option<f64>,
+    /// Whether the floor's faster loop was the one that prefetches (`lab::floor::Floor::run`).
+    #[serde(default)]
+    pub floor_lookahead: Option<bool>,
+    /// `collisions_per_second / floor_collisions_per_second`.
+    #[serde(default)]
+    pub fraction_of_floor: Option<f64>,
 }
 
 /// The process's peak resident set size (Linux `VmHWM`), if readable.
@@ -88,22 +100,33 @@ pub fn measure(
     }
     let seconds = start.elapsed().as_secs_f64();
     let events_by_kind = sim.counts().since(&before);
+    let (engine_bytes, crowded, lists) = (sim.memory_bytes(), sim.crowded(), sim.lists());
+    // Read before the floor allocates; the engine's memory goes first.
+    let (peak_rss_bytes, huge_page_bytes) = (peak_rss_bytes(), crate::engine::pages::huge_page_bytes());
+    drop(sim);
+    // (The floor needs a full row of neighbours: none below 2·WIDTH disks.)
+    let floor =
+        (n >= 2 * super::floor::WIDTH).then(|| super::floor::measure(n, eta, 2 * n as u64, timed, seed)).transpose()?;
+    let collisions_per_second = timed as f64 / seconds;
     Ok(BenchPoint {
         n_particles: n,
         packing_fraction: eta,
         neighbourhood,
-        lists: sim.lists(),
+        lists,
         warmup_collisions: warmup,
         collisions: timed,
         seconds,
-        collisions_per_second: timed as f64 / seconds,
+        collisions_per_second,
         ns_per_collision: seconds * 1e9 / timed as f64,
         events_per_second: events_by_kind.total() as f64 / seconds,
         events_by_kind,
-        engine_bytes_per_particle: sim.memory_bytes() as f64 / n as f64,
-        crowded_fraction: sim.crowded() as f64 / n as f64,
-        peak_rss_bytes: peak_rss_bytes(),
-        huge_page_bytes: crate::engine::pages::huge_page_bytes(),
+        engine_bytes_per_particle: engine_bytes as f64 / n as f64,
+        crowded_fraction: crowded as f64 / n as f64,
+        peak_rss_bytes,
+        huge_page_bytes,
+        floor_collisions_per_second: floor.as_ref().map(|f| f.collisions_per_second),
+        floor_lookahead: floor.as_ref().map(|f| f.lookahead),
+        fraction_of_floor: floor.map(|f| collisions_per_second / f.collisions_per_second),
     })
 }
 
@@ -147,8 +170,8 @@ pub fn today() -> String {
 pub fn markdown(points: &[BenchPoint], command: &str, machine: &str) -> String {
     let mut md = format!(
         "# collide benchmark report\n\n{} · collide {} · {machine} · one core\n\nCommand: `{command}`\n\n\
-         | N | η | neighbourhood | collisions/s | ns/collision | events/s | pair : wall : rebuild : stale per collision | engine bytes/particle | peak RSS bytes/particle |\n\
-         |---|---|---|---|---|---|---|---|---|\n",
+         | N | η | neighbourhood | collisions/s | ns/collision | events/s | pair : wall : rebuild : stale per collision | engine bytes/particle | peak RSS bytes/particle | floor collisions/s | of the floor |\n\
+         |---|---|---|---|---|---|---|---|---|---|---|\n",
         today(),
         env!("CARGO_PKG_VERSION")
     );
@@ -156,7 +179,7 @@ pub fn markdown(points: &[BenchPoint], command: &str, machine: &str) -> String {
         let e = &p.events_by_kind;
         let per = |x: u64| x as f64 / e.pair.max(1) as f64;
         md.push_str(&format!(
-            "| {} | {} | {} | {:.3e} | {:.0} | {:.3e} | 1 : {:.2} : {:.2} : {:.2} | {:.0} | {} |\n",
+            "| {} | {} | {} | {:.3e} | {:.0} | {:.3e} | 1 : {:.2} : {:.2} : {:.2} | {:.0} | {} | {} | {} |\n",
             p.n_particles,
             p.packing_fraction,
             if p.lists { "lists" } else { "grid" },
@@ -168,14 +191,25 @@ pub fn markdown(points: &[BenchPoint], command: &str, machine: &str) -> String {
             per(e.stale),
             p.engine_bytes_per_particle,
             p.peak_rss_bytes.map_or("—".into(), |b| format!("{:.0}", b as f64 / p.n_particles as f64)),
+            p.floor_collisions_per_second.map_or("—".into(), |f| format!("{f:.3e}")),
+            p.fraction_of_floor.map_or("—".into(), |f| format!("{:.1} %", 100.0 * f)),
         ));
     }
+    md.push_str(
+        "\nThe floor: the same N and η with nothing but moving two disks, bouncing them and \
+         re-predicting both against eight fixed neighbours with the textbook formula (no queue, \
+         no list upkeep, no exact times; `collide::lab::floor`), measured in the same process.\n",
+    );
     md
 }
 
-/// The chart: collisions per second against N (log₁₀ N on the x axis), one line per η.
+/// The chart: collisions per second against N (log₁₀ N on the x axis), one series per η,
+/// and the floor's beside them.
 pub fn chart(points: &[BenchPoint]) -> Chart {
     let mut etas: Vec<f64> = points.iter().map(|p| p.packing_fraction).collect();
+    // Sorted first: the matrix runs N by N, so equal packing fractions are not adjacent (an
+    // unsorted dedup drew every series once per N).
+    etas.sort_by(f64::total_cmp);
     etas.dedup();
     Chart {
         title: "Steady-state collisions per second (one core)".into(),
@@ -184,15 +218,18 @@ pub fn chart(points: &[BenchPoint]) -> Chart {
         legend_left: false,
         series: etas
             .iter()
-            .map(|&eta| {
-                Series::points(
-                    &format!("η = {eta}"),
+            .flat_map(|&eta| {
+                let at = |rate: fn(&BenchPoint) -> Option<f64>| -> Vec<(f64, f64)> {
                     points
                         .iter()
                         .filter(|p| p.packing_fraction == eta)
-                        .map(|p| ((p.n_particles as f64).log10(), p.collisions_per_second / 1e6))
-                        .collect(),
-                )
+                        .filter_map(|p| Some(((p.n_particles as f64).log10(), rate(p)? / 1e6)))
+                        .collect()
+                };
+                let engine = Series::points(&format!("η = {eta}"), at(|p| Some(p.collisions_per_second)));
+                let floor = at(|p| p.floor_collisions_per_second);
+                let floor = (!floor.is_empty()).then(|| Series::line(&format!("floor, η = {eta}"), floor));
+                std::iter::once(engine).chain(floor)
             })
             .collect(),
     }

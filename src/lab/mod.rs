@@ -10,6 +10,7 @@ pub mod check;
 pub mod collision_rate;
 pub mod equation_of_state;
 pub mod equipartition;
+pub mod floor;
 pub mod maxwell_boltzmann;
 pub mod plot;
 pub mod report;
