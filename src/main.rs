@@ -35,8 +35,9 @@ enum Command {
     /// Runs every physics experiment and writes a validation report (`index.html`,
     /// `report.md`); the default when no command is given. Exits non-zero if a check fails.
     Validate(ValidateArgs),
-    /// Benchmark report: steady-state collisions per second over N × packing fraction,
-    /// written to DIR/bench.json, bench.md and collisions_per_second.svg.
+    /// Benchmark report: steady-state collisions per second over N × packing fraction, and
+    /// the hardware's floor beside each point, written to DIR/bench.json, bench.md and
+    /// collisions_per_second.svg.
     Bench(BenchArgs),
     /// One benchmark point in a process of its own (used by `collide bench`).
     #[command(hide = true)]

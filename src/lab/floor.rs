@@ -366,7 +366,8 @@ fn nearest(disks: &[Disk], sim_box: &SimBox<2>, brute: bool) -> Vec<[u32; WIDTH]
 pub fn measure_both(n: usize, eta: f64, warmup: u64, timed: u64, seed: u64) -> Result<[FloorPoint; 2], String> {
     let one = |lookahead| -> Result<FloorPoint, String> {
         let mut floor = Floor::new(n, eta, seed)?;
-        let mut rng = Xoshiro256PlusPlus::seed_from_u64(seed ^ 0x666c_6f6f_72);
+        // The draws get a stream of their own (the initial state used `seed`).
+        let mut rng = Xoshiro256PlusPlus::seed_from_u64(seed ^ u64::from_be_bytes(*b"\0\0\0floor"));
         floor.run(&mut rng, warmup, lookahead);
         let start = Instant::now();
         floor.run(&mut rng, timed, lookahead);
