@@ -5,19 +5,25 @@
 //! a bare kernel: *move two disks, bounce, re-predict both against neighbour lists padded to
 //! the SIMD width; no queue, no list upkeep*. This module is that loop, written from the
 //! description, so that the floor can be measured on whatever machine the benchmark report
-//! runs on and the engine's rate given as a fraction of it (the machine-independent figure:
-//! the issue quotes the fastest published code at 11–22 % of the floor it measured).
+//! runs on and the engine's rate given as a fraction of it — the figure that travels
+//! between hours and machines better than a rate (the issue quotes the fastest published
+//! code at 11–22 % of the floor it measured).
 //!
-//! One step of the floor:
+//! One step of the floor ([`Floor::collide`]):
 //!
 //! 1. a disk `i`, drawn uniformly (so that at large N the records come from anywhere in
 //!    memory, as the events of a real run do), and its predicted partner `j`;
-//! 2. the clock advances by a fixed `Δt`; both disks move to it ballistically;
+//! 2. both disks moved ballistically to the contact predicted for `i`;
 //! 3. the bounce: equal masses, the velocities exchanged along the line of centres
 //!    (minimum image) when the pair approaches, by a select, not a branch;
 //! 4. both disks re-predicted against their eight listed neighbours with the textbook
-//!    formula `t = (−b − √(b² − ac))/a` (`b = Δr·Δv`, `a = |Δv|²`, `c = |Δr|² − σ²`), all
-//!    eight lanes computed and the earliest taken without branches.
+//!    formula `t = (−b − √(b² − ac))/a` (`b = Δr·Δv`, `a = |Δv|²`, `c = |Δr|² − σ²`), the
+//!    eight lanes gathered first and computed as vectors, the earliest taken without
+//!    branches.
+//!
+//! [`Floor::run`] draws the disks [`AHEAD`] steps early and can prefetch their data in three
+//! stages (what keeps a code from waiting on memory at large N); [`measure`] takes the
+//! faster of the loops with and without that.
 //!
 //! What it leaves out is everything a correct simulation needs beyond that: an event queue
 //! (the pair is drawn, not the earliest), list rebuilds (the lists are the eight nearest
@@ -51,7 +57,7 @@ pub struct FloorPoint {
     pub n_particles: usize,
     /// Packing fraction of the initial lattice.
     pub packing_fraction: f64,
-    /// Whether the faster loop was the one that prefetches ([`Floor::run`]).
+    /// Whether this loop prefetched ([`Floor::run`]).
     pub lookahead: bool,
     /// Timed steps (one collision each).
     pub collisions: u64,
