@@ -5,7 +5,8 @@
 //!
 //! `engine/floor` times the hardware's floor (`collide::lab::floor`: two disks moved,
 //! bounced and re-predicted against eight fixed neighbours, no queue) at N = 10⁴ and 10⁵,
-//! η = 0.65, per collision: what the engine's rate is a fraction of.
+//! η = 0.65, per collision, without and with its lookahead: what the engine's rate is a
+//! fraction of.
 //!
 //! `engine/parts` times pieces of one collision's work at N = 10⁴, η = 0.65, to show where
 //! the time goes: `bracket_pair` over every pair of a warmed-up state closer than 1.8σ (per
@@ -65,9 +66,19 @@ fn floor(c: &mut Criterion) {
     let mut group = c.benchmark_group("engine/floor");
     group.throughput(Throughput::Elements(1));
     for n in [10_000, 100_000] {
-        let mut floor = collide::lab::floor::Floor::new(n, 0.65, 1).unwrap();
-        let mut rng = Xoshiro256PlusPlus::seed_from_u64(2);
-        group.bench_function(BenchmarkId::new("eta=0.65", n), |b| b.iter(|| floor.collide(rng.random_range(0..n))));
+        // Both loops, as `collide bench` times them (it reports the faster).
+        for lookahead in [false, true] {
+            let mut floor = collide::lab::floor::Floor::new(n, 0.65, 1).unwrap();
+            let mut rng = Xoshiro256PlusPlus::seed_from_u64(2);
+            let name = if lookahead { "eta=0.65/lookahead" } else { "eta=0.65/plain" };
+            group.bench_function(BenchmarkId::new(name, n), |b| {
+                b.iter_custom(|iters| {
+                    let start = Instant::now();
+                    floor.run(&mut rng, iters, lookahead);
+                    start.elapsed()
+                })
+            });
+        }
     }
     group.finish();
 }
