@@ -214,8 +214,9 @@ impl Tree {
     /// it this walk. Leaving out 2·4^s of N particles, the guess was right (the owner of the
     /// next step's event) 98.7 % of the time at N = 10⁵ with s = 5, against 99.9 % with the
     /// whole walk (4.1·10⁶ steps counted, η = 0.65), and N = 10⁵ ran 13–14 % faster with
-    /// s = 3 and 7 % faster again with s = 5 (s = 6: 7 % slower; alternating runs, see the
-    /// README). A wrong guess costs only time: the results are the same bit for bit.
+    /// s = 3 and 7 % faster again with s = 5 (s = 6: 7 % slower; alternating runs, see
+    /// `benches/HISTORY.md`). A wrong guess costs only time: the results are the same bit
+    /// for bit.
     #[inline]
     pub fn guess_next(&self, a: usize, b: usize) -> usize {
         self.earliest_beside(a, b, self.skip)
