@@ -9,7 +9,7 @@
 
 use super::plot::{Chart, Series};
 use crate::engine::init::{Placement, Species, Velocities, box_for_packing_fraction, initial_particles};
-use crate::engine::{Boundary, EventCounts, Neighbourhood, Simulation};
+use crate::engine::{Boundary, EventCounts, Neighbourhood, Particle, SimBox, Simulation};
 use serde::{Deserialize, Serialize};
 use std::time::Instant;
 
@@ -73,6 +73,17 @@ pub fn peak_rss_bytes() -> Option<u64> {
     Some(kb * 1024)
 }
 
+/// A benchmark point's initial state: N disks of diameter 1 on a triangular lattice at
+/// packing fraction `eta` in a periodic box, Maxwell velocities at kT = 1 (the engine's and
+/// the floor's, [`super::floor`], alike).
+pub fn initial_state(n: usize, eta: f64, seed: u64) -> Result<(Vec<Particle<2>>, SimBox<2>), String> {
+    let species = vec![Species { count: n, radius: 0.5, mass: 1.0 }];
+    let sim_box = box_for_packing_fraction(&species, eta, [Boundary::Periodic; 2], Placement::Triangular, 1.0);
+    let particles = initial_particles(&species, &sim_box, Placement::Triangular, Velocities::Maxwell, 1.0, seed)
+        .map_err(|e| e.to_string())?;
+    Ok((particles, sim_box))
+}
+
 /// Measures one point: `warmup_per_particle` untimed collisions per particle, then
 /// `timed` collisions, with the neighbourhood asked for.
 pub fn measure(
@@ -83,10 +94,7 @@ pub fn measure(
     timed: u64,
     seed: u64,
 ) -> Result<BenchPoint, String> {
-    let species = vec![Species { count: n, radius: 0.5, mass: 1.0 }];
-    let sim_box = box_for_packing_fraction(&species, eta, [Boundary::Periodic; 2], Placement::Triangular, 1.0);
-    let particles = initial_particles(&species, &sim_box, Placement::Triangular, Velocities::Maxwell, 1.0, seed)
-        .map_err(|e| e.to_string())?;
+    let (particles, sim_box) = initial_state(n, eta, seed)?;
     let mut sim = Simulation::with_neighbourhood(particles, sim_box, neighbourhood).map_err(|e| e.to_string())?;
     let warmup = warmup_per_particle * n as u64;
     while sim.counts().pair < warmup {

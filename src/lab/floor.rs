@@ -34,10 +34,9 @@
 //! eight straddled two lines, and N = 10⁶ took 340–400 ns a collision against 150–280);
 //! lists are 32 bytes a row, partners 4 bytes and due times 8.
 
-use crate::engine::init::{Placement, Species, Velocities, box_for_packing_fraction, initial_particles};
+use crate::engine::SimBox;
 use crate::engine::pages;
 use crate::engine::prefetch::prefetch;
-use crate::engine::{Boundary, SimBox};
 use rand::rngs::Xoshiro256PlusPlus;
 use rand::{RngExt, SeedableRng};
 use serde::{Deserialize, Serialize};
@@ -97,10 +96,7 @@ impl Floor {
         if n < 2 * WIDTH {
             return Err(format!("the floor needs at least {} disks, got {n}", 2 * WIDTH));
         }
-        let species = vec![Species { count: n, radius: 0.5, mass: 1.0 }];
-        let sim_box = box_for_packing_fraction(&species, eta, [Boundary::Periodic; 2], Placement::Triangular, 1.0);
-        let particles = initial_particles(&species, &sim_box, Placement::Triangular, Velocities::Maxwell, 1.0, seed)
-            .map_err(|e| e.to_string())?;
+        let (particles, sim_box) = super::bench::initial_state(n, eta, seed)?;
         // In 2 MB pages where large, as the engine's arrays (`engine::pages`).
         let disks: Vec<Disk> = pages::collect(particles.iter().map(|p| Disk {
             position: p.position.into(),
@@ -401,6 +397,7 @@ pub fn measure(n: usize, eta: f64, warmup: u64, timed: u64, seed: u64) -> Result
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::engine::Boundary;
     use quadratic::{Ball, Contact, textbook};
 
     #[test]
