@@ -29,7 +29,7 @@ use std::time::{Duration, Instant};
 
 fn warmed_up(n: usize, eta: f64) -> Simulation<2> {
     let species = vec![Species { count: n, radius: 0.5, mass: 1.0 }];
-    let sim_box = box_for_packing_fraction(&species, eta, [Boundary::Periodic; 2], Placement::Triangular, 1.0);
+    let sim_box = box_for_packing_fraction(&species, eta, [Boundary::Periodic; 2], Placement::Triangular, None);
     let particles = initial_particles(&species, &sim_box, Placement::Triangular, Velocities::Maxwell, 1.0, 1).unwrap();
     let mut sim = Simulation::new(particles, sim_box).unwrap();
     // As `collide bench` does: the lattice relaxes (see `collide::lab::bench::WARMUP`).

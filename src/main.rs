@@ -21,7 +21,13 @@ macro_rules! say {
 }
 
 #[derive(Parser)]
-#[command(name = "collide", version, about = "Event-driven hard-disk dynamics on verified collision numerics")]
+#[command(
+    name = "collide",
+    version,
+    about = "Event-driven hard-disk dynamics on verified collision numerics",
+    disable_help_subcommand = true,
+    after_help = "Exit status: 0 success; 1 a check failed, a run was stopped by its watchdog, or a JSON line could not be answered; 2 bad input (arguments, configuration, checkpoint, output directory); 130 interrupted (SIGINT or SIGTERM: the run saved a checkpoint and a summary)."
+)]
 struct Cli {
     #[command(subcommand)]
     command: Option<Command>,
@@ -74,6 +80,23 @@ enum Command {
     Roots(RootsArgs),
     /// Earliest contact time of two disks (or spheres): prints the time, or "never".
     ContactTime(ContactArgs),
+    /// Runs one physics experiment and writes DIR/NAME/result.json and its plots; exits 1
+    /// if a check fails. `collide validate` runs them all.
+    Experiment(ExperimentArgs),
+    /// Prints the help of collide, or of one of its commands.
+    Help {
+        /// The command.
+        command: Option<String>,
+    },
+}
+
+#[derive(Args)]
+struct ExperimentArgs {
+    /// Which experiment.
+    #[arg(value_parser = clap::builder::PossibleValuesParser::new(collide::lab::report::EXPERIMENTS.iter().map(|(name, _)| *name)))]
+    name: String,
+    #[command(flatten)]
+    options: collide::lab::ExperimentArgs,
 }
 
 #[derive(Args)]
@@ -113,9 +136,20 @@ struct BenchArgs {
 struct RunArgs {
     /// The configuration (TOML). Omit it to run the embedded default.
     config: Option<PathBuf>,
-    /// Output directory (created if needed).
+    /// Output directory (created if needed). It holds one run: one that holds another run's
+    /// files is refused, unless --force.
     #[arg(long, default_value = "collide-out")]
     out: PathBuf,
+    /// Replace the files of an earlier run in the output directory (only those:
+    /// summary.json, timeseries.csv, trajectory.xyz, checkpoint.json).
+    #[arg(long)]
+    force: bool,
+    /// No progress bar (it is drawn only on a terminal, and never when CI is set).
+    #[arg(long)]
+    quiet: bool,
+    /// Stop as SIGINT would once production has this many collisions (tests).
+    #[arg(long, hide = true)]
+    interrupt_after: Option<u64>,
     /// Continue from a checkpoint written by an earlier run (instead of a configuration).
     #[arg(long, conflicts_with = "config")]
     resume: Option<PathBuf>,
@@ -206,7 +240,44 @@ fn run(cli: Cli) -> Result<ExitCode> {
         Command::Run(args) => run_simulation(args),
         Command::Roots(args) => roots(args),
         Command::ContactTime(args) => contact(args),
+        Command::Experiment(args) => {
+            let (name, experiment) = collide::lab::report::EXPERIMENTS
+                .iter()
+                .find(|(name, _)| *name == args.name)
+                .expect("clap checked the name");
+            Ok(collide::lab::run_one(name, *experiment, &args.options.into()))
+        }
+        Command::Help { command } => help(command.as_deref()),
     }
+}
+
+fn help(command: Option<&str>) -> Result<ExitCode> {
+    use clap::CommandFactory;
+    let mut cli = Cli::command();
+    cli.build();
+    match command {
+        None => cli.print_long_help()?,
+        Some(name) => match cli.find_subcommand_mut(name) {
+            Some(sub) => sub.print_long_help()?,
+            None => {
+                let names: Vec<String> =
+                    cli.get_subcommands().filter(|c| !c.is_hide_set()).map(|c| c.get_name().to_string()).collect();
+                bail!(
+                    "help: there is no command '{}' (commands: {})",
+                    collide::io::text::excerpt(name),
+                    names.join(", ")
+                );
+            }
+        },
+    }
+    Ok(ExitCode::SUCCESS)
+}
+
+/// Whether to draw a progress bar on stderr: on a terminal, unless asked not to or under CI
+/// (`CI` set to anything but empty, `0` or `false`).
+fn progress_wanted(quiet: bool) -> bool {
+    let ci = std::env::var("CI").is_ok_and(|v| !matches!(v.trim(), "" | "0" | "false"));
+    !quiet && !ci && io::stderr().is_terminal()
 }
 
 fn check() -> Result<ExitCode> {
@@ -300,12 +371,15 @@ fn contact(args: ContactArgs) -> Result<ExitCode> {
 
 fn run_simulation(args: RunArgs) -> Result<ExitCode> {
     use collide::io::config::{Config, DEFAULT_CONFIG};
-    use collide::io::output::{RunFailure, execute, load_checkpoint, run_config};
+    use collide::io::output::{RunFailure, RunOptions, Start, load_checkpoint, run_into};
+    use collide::run::{Phase, Status};
+    use std::sync::Arc;
+    use std::sync::atomic::AtomicBool;
     if args.print_default {
         say!("{}", DEFAULT_CONFIG.trim_end());
         return Ok(ExitCode::SUCCESS);
     }
-    let bar = if io::stderr().is_terminal() {
+    let bar = if progress_wanted(args.quiet) {
         let bar = indicatif::ProgressBar::new(1000);
         bar.set_style(
             indicatif::ProgressStyle::with_template("{prefix} [{bar:40}] {percent:>3}% {elapsed_precise} (eta {eta})")
@@ -316,29 +390,66 @@ fn run_simulation(args: RunArgs) -> Result<ExitCode> {
     } else {
         indicatif::ProgressBar::hidden()
     };
-    let tick = |prefix: &'static str| {
-        let bar = bar.clone();
-        move |f: f64| {
-            bar.set_prefix(prefix);
-            bar.set_position((f * 1000.0) as u64);
+    let mut shown = None;
+    let progress = |phase: Phase, done: f64| {
+        if shown != Some(phase) {
+            // A new phase starts its bar (and its estimate) from zero.
+            shown = Some(phase);
+            bar.reset();
+            bar.set_prefix(if phase == Phase::Production { "running" } else { "equilibrating" });
+        }
+        bar.set_position((done.clamp(0.0, 1.0) * 1000.0) as u64);
+    };
+    // SIGINT and SIGTERM set the flag; the run stops at its next event and saves itself.
+    let stop = Arc::new(AtomicBool::new(false));
+    for signal in [signal_hook::consts::SIGINT, signal_hook::consts::SIGTERM] {
+        signal_hook::flag::register(signal, Arc::clone(&stop)).context("installing the signal handlers")?;
+    }
+    let (start, source) = if let Some(path) = &args.resume {
+        let checkpoint = load_checkpoint(path).map_err(anyhow::Error::msg)?;
+        (Start::Resume { checkpoint, path }, path.display().to_string())
+    } else {
+        match &args.config {
+            Some(path) => (Start::Fresh(Config::load(path)?), path.display().to_string()),
+            None => (Start::Fresh(Config::default_config()), "the embedded default".to_string()),
         }
     };
-    let summary = if let Some(path) = &args.resume {
-        let checkpoint = load_checkpoint(path).map_err(anyhow::Error::msg)?;
-        let mut run = collide::run::Run::resume(checkpoint).with_context(|| path.display().to_string())?;
-        execute(&mut run, &args.out, tick("running")).context("writing results")?
-    } else {
-        let (config, source) = match &args.config {
-            Some(path) => (Config::load(path)?, path.display().to_string()),
-            None => (Config::default_config(), "the embedded default".to_string()),
-        };
-        run_config(config, &args.out, tick("equilibrating"), tick("running")).map_err(|e| match e {
-            // A bad initial state is the configuration's fault: name it.
-            RunFailure::Run(e) => anyhow::anyhow!("{source}: {e}"),
-            RunFailure::Output(e) => anyhow::anyhow!("writing results: {e}"),
-        })?
-    };
+    let options = RunOptions { force: args.force, interrupt_after: args.interrupt_after };
+    let summary = run_into(start, &args.out, options, &stop, progress).map_err(|e| match e {
+        // A bad configuration, initial state or checkpoint: name where it came from.
+        RunFailure::Run(e) => anyhow::anyhow!("{source}: {e}"),
+        RunFailure::Output(e) => anyhow::anyhow!("{e}"),
+        e => anyhow::anyhow!("{e}"),
+    })?;
     bar.finish_and_clear();
+    for warning in &summary.warnings {
+        eprintln!("collide: warning: {warning}");
+    }
+    let out = args.out.display();
+    match summary.status {
+        Status::Interrupted => {
+            eprintln!(
+                "collide: interrupted at t = {} ({} production collisions); results so far in {out} (summary.json says \"interrupted\"); continue with: collide run --resume {} --out {out}",
+                summary.sim_time,
+                summary.collisions,
+                args.out.join("checkpoint.json").display()
+            );
+            return Ok(ExitCode::from(130));
+        }
+        Status::Stalled => {
+            let why = summary.stall.as_ref().map_or_else(String::new, |s| s.to_string());
+            eprintln!("collide: {source}: stopped: {why}; results so far in {out}");
+            return Ok(ExitCode::FAILURE);
+        }
+        Status::TooManySamples => {
+            eprintln!(
+                "collide: {source}: stopped at {} samples, the most a run keeps: use a larger run.sample_interval; results so far in {out}",
+                summary.samples
+            );
+            return Ok(ExitCode::FAILURE);
+        }
+        _ => {}
+    }
     say!(
         "{} collisions in {:.2} s ({:.3} M/s); kT = {:.6}; P = {:.6} ± {:.6}; Z = {:.5} ± {:.5}; max overlap {:.2e}; energy drift {:.2e}",
         summary.collisions,
@@ -352,7 +463,7 @@ fn run_simulation(args: RunArgs) -> Result<ExitCode> {
         summary.max_overlap.fraction,
         summary.energy_relative_drift
     );
-    say!("results in {}", args.out.display());
+    say!("results in {out}");
     Ok(ExitCode::SUCCESS)
 }
 

@@ -25,7 +25,7 @@ fn next_pair(sim: &mut Simulation<2>) -> (usize, usize) {
     loop {
         match sim.step().expect("an event") {
             Outcome::Pair { i, j, .. } => return (i, j),
-            Outcome::Rebuild => continue,
+            Outcome::Rebuild { .. } => continue,
             other => panic!("unexpected {other:?}"),
         }
     }
@@ -68,7 +68,7 @@ fn wall_bounce_reverses_the_normal_velocity_with_impulse_2mv() {
                 assert_eq!((i, axis, upper, impulse), (0, 0, false, 2.0 * 1.5 * 2.0));
                 break;
             }
-            Outcome::Rebuild => {}
+            Outcome::Rebuild { .. } => {}
             other => panic!("unexpected {other:?}"),
         }
     }
@@ -89,7 +89,7 @@ fn random_system(
         vec![Species { count: n, radius: 0.5, mass: 1.0 }]
     };
     let placement = Placement::Random;
-    let sim_box = box_for_packing_fraction(&species, eta, boundary, placement, 1.0);
+    let sim_box = box_for_packing_fraction(&species, eta, boundary, placement, None);
     let particles = initial_particles(&species, &sim_box, placement, Velocities::Maxwell, 1.0, seed).unwrap();
     (particles, sim_box)
 }
@@ -155,7 +155,7 @@ fn dense_lattices(count: usize) -> Vec<(Placement, Vec<Particle<2>>, SimBox<2>)>
         .into_iter()
         .map(|(placement, eta, boundary)| {
             let species = vec![Species { count, radius: 0.5, mass: 1.0 }];
-            let sim_box = box_for_packing_fraction(&species, eta, boundary, placement, 1.0);
+            let sim_box = box_for_packing_fraction(&species, eta, boundary, placement, None);
             let particles = initial_particles(&species, &sim_box, placement, Velocities::Maxwell, 1.0, 9).unwrap();
             (placement, particles, sim_box)
         })

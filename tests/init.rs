@@ -5,7 +5,7 @@ use collide::engine::{Boundary, Simulation};
 
 fn build(n: usize, eta: f64, placement: Placement, velocities: Velocities, boundary: [Boundary; 2]) -> Simulation<2> {
     let species = vec![Species { count: n, radius: 0.5, mass: 2.0 }];
-    let sim_box = box_for_packing_fraction(&species, eta, boundary, placement, 1.0);
+    let sim_box = box_for_packing_fraction(&species, eta, boundary, placement, None);
     let particles = initial_particles(&species, &sim_box, placement, velocities, 1.5, 42).unwrap();
     Simulation::new(particles, sim_box).expect("a valid initial state")
 }

@@ -4,7 +4,7 @@
 use collide::engine::{Boundary, Outcome, Particle, SimBox, Simulation};
 use collide::io::config::Config;
 use collide::observe::block_error;
-use collide::run::{Run, Summary};
+use collide::run::{Checkpoint, Run, Summary};
 use nalgebra::Vector2;
 
 const EPS: f64 = f64::EPSILON;
@@ -17,7 +17,7 @@ fn run_to_end(mut run: Run) -> (Run, Summary) {
     while !run.done() {
         run.step().expect("events keep coming");
     }
-    let summary = run.summary(1.0);
+    let summary = run.summary();
     (run, summary)
 }
 
@@ -92,9 +92,9 @@ fn checkpoint_and_resume_equal_an_uninterrupted_run() {
     while first.collisions() < 17_321 {
         first.step().unwrap();
     }
-    let text = serde_json::to_string(&first.checkpoint()).unwrap();
+    let text = first.checkpoint(0).to_json();
     drop(first);
-    let resumed = Run::resume(serde_json::from_str(&text).unwrap()).unwrap();
+    let resumed = Run::resume(Checkpoint::from_json(text.as_bytes()).unwrap()).unwrap();
     let (resumed, got) = run_to_end(resumed);
     assert_eq!(got, expected);
     assert_eq!(resumed.sim.particles(), whole.sim.particles());

@@ -256,6 +256,11 @@ impl<const D: usize> Cells<D> {
         (best_axis != usize::MAX).then_some((best_dt, best_axis, best_up))
     }
 
+    /// The width of a cell along `axis`.
+    pub fn width(&self, axis: usize) -> f64 {
+        self.widths[axis]
+    }
+
     /// Cells per axis.
     pub fn counts(&self) -> [usize; D] {
         self.counts

@@ -237,7 +237,7 @@ pub const LANES: usize = 8;
 /// infinite bound still asks [`predict_pair`]). Lanes `k ≥ len` give `[+∞, +∞]` whatever
 /// `js[k]` holds, so a caller can always pass full chunks. Returns the smallest `hi[k]`.
 ///
-/// The balls are exactly those [`pair_balls`] forms (so the certified intervals are
+/// The balls are exactly those `pair_balls` forms (so the certified intervals are
 /// [`bracket_pair`]'s to the bit), but built lane by lane without branches: the neighbours'
 /// states are gathered first, then the separations and image counts are computed for all
 /// lanes at once, which the compiler vectorizes. Built one pair at a time, the lanes cost
@@ -485,10 +485,36 @@ pub fn resolve_wall_event<const D: usize>(p: &mut Particle<D>, axis: usize, uppe
 /// owner changes velocity it is predicted again at once.
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
 pub struct Pending {
-    /// When (`+∞` for nothing).
+    /// When (`+∞` for nothing; written `"inf"` in JSON, which has no infinity).
+    #[serde(with = "extended_float")]
     pub time: f64,
     /// What.
     pub kind: PendingKind,
+}
+
+/// An f64 in JSON with its infinities: finite values as numbers, `±∞` as the strings
+/// `"inf"` and `"-inf"` (serde_json writes them as `null`, which reads back as no number).
+mod extended_float {
+    use serde::{Deserialize, Deserializer, Serializer, de};
+
+    pub fn serialize<S: Serializer>(x: &f64, s: S) -> Result<S::Ok, S::Error> {
+        match *x {
+            f64::INFINITY => s.serialize_str("inf"),
+            f64::NEG_INFINITY => s.serialize_str("-inf"),
+            x => s.serialize_f64(x),
+        }
+    }
+
+    // Through a JSON value: serde_json's exact numbers (`arbitrary_precision`) do not pass
+    // through serde's untagged enums.
+    pub fn deserialize<'de, D: Deserializer<'de>>(d: D) -> Result<f64, D::Error> {
+        match serde_json::Value::deserialize(d)? {
+            serde_json::Value::Number(n) => n.as_f64().ok_or_else(|| de::Error::custom(format!("{n} is not an f64"))),
+            serde_json::Value::String(w) if w == "inf" => Ok(f64::INFINITY),
+            serde_json::Value::String(w) if w == "-inf" => Ok(f64::NEG_INFINITY),
+            _ => Err(de::Error::custom("expected a number, \"inf\" or \"-inf\"")),
+        }
+    }
 }
 
 /// What a [`Pending`] event is about.

@@ -12,7 +12,7 @@
 //! * [`pages`]: huge pages for the large arrays (with `prefetch`, the crate's only `unsafe` code).
 //! * `prefetch`: the cache hint of the lookahead.
 //! * [`simulation`]: the event loop.
-//! * [`reference`]: the O(N²) reference.
+//! * [`reference`](mod@reference): the O(N²) reference.
 //! * [`init`]: initial states (lattices, random placement, Maxwell or fixed-speed velocities).
 
 pub mod cache;
@@ -32,4 +32,4 @@ pub use collision::{Body, Impulse, Restitution, RestitutionError, resolve_pair};
 pub use geometry::{Boundary, Particle, SimBox};
 pub use neighbours::{Neighbourhood, UnknownNeighbourhood};
 pub use reference::ReferenceSimulation;
-pub use simulation::{EventCounts, Outcome, OverlapAudit, SetupError, Simulation, SimulationState};
+pub use simulation::{EventCounts, Outcome, OverlapAudit, SetupError, Simulation, SimulationState, check_box};

@@ -234,18 +234,21 @@ pub struct Neighbours<const D: usize> {
 }
 
 /// How a saved [`Neighbours`] is restored: the grid's unwrapped cell coordinates, or the
-/// list centres.
+/// list centres and which particles are crowded.
 #[derive(Clone, Debug)]
 pub enum Saved<const D: usize> {
     /// Following: one unwrapped cell coordinate per particle.
     Cells(Vec<[i64; D]>),
-    /// Lists: one centre per particle.
-    Centres(Vec<SVector<f64, D>>),
+    /// Lists: one centre per particle, and the crowded particles in increasing order. A
+    /// particle stays crowded until its next rebuild even when neighbours leave its range
+    /// (a crowded particle keeps no list to leave), so whether it is crowded is state: it
+    /// decides which stale predictions it makes, and a restored run must make the same.
+    Centres(Vec<SVector<f64, D>>, Vec<u32>),
 }
 
 impl<const D: usize> Neighbours<D> {
     /// Lists (centred where the particles are at `time`) or a grid following the particles,
-    /// as [`skin_for`] decides; `allow_lists` is false with short periodic axes.
+    /// as `skin_for` decides; `allow_lists` is false with short periodic axes.
     pub fn new(
         sim_box: &SimBox<D>,
         reach: f64,
@@ -257,7 +260,7 @@ impl<const D: usize> Neighbours<D> {
         match skin_for(sim_box, reach, particles.len(), allow_lists, choice) {
             Some(_) => {
                 let centres = particles.iter().map(|p| p.position_at(time)).collect();
-                Self::restore(sim_box, reach, particles.len(), allow_lists, choice, Saved::Centres(centres))
+                Self::restore(sim_box, reach, particles.len(), allow_lists, choice, Saved::Centres(centres, Vec::new()))
                     .expect("one centre per particle")
             }
             None => Self::following(sim_box, reach, particles),
@@ -298,7 +301,13 @@ impl<const D: usize> Neighbours<D> {
         let empty = |cells| Self::bare(sim_box, cells);
         match (skin, saved) {
             (None, Saved::Cells(coords)) if coords.len() == n => Ok(empty(Cells::from_coords(sim_box, reach, coords))),
-            (Some(skin), Saved::Centres(centres)) if centres.len() == n => {
+            (Some(skin), Saved::Centres(centres, crowded)) if centres.len() == n => {
+                if let Some(&k) = crowded.iter().find(|&&k| k as usize >= n) {
+                    return Err(format!("crowded particle {k} of {n}"));
+                }
+                if crowded.windows(2).any(|w| w[0] >= w[1]) {
+                    return Err("the crowded particles are not listed in increasing order".into());
+                }
                 let range = reach + skin;
                 let half = 0.5 * skin * (1.0 - f64::EPSILON * (1u64 << 32) as f64);
                 let centres = pages::moved(centres);
@@ -312,6 +321,9 @@ impl<const D: usize> Neighbours<D> {
                     neighbours.scan(i);
                     List::from_members(&neighbours.scratch)
                 }));
+                for &k in &crowded {
+                    neighbours.lists[k as usize] = List::CROWDED;
+                }
                 Ok(neighbours)
             }
             (skin, _) => Err(format!(
@@ -324,7 +336,10 @@ impl<const D: usize> Neighbours<D> {
     /// What [`restore`](Self::restore) takes back.
     pub fn save(&self) -> Saved<D> {
         match self.listed() {
-            true => Saved::Centres(self.centres.clone()),
+            true => Saved::Centres(
+                self.centres.clone(),
+                (0..self.lists.len() as u32).filter(|&k| self.lists[k as usize].crowded()).collect(),
+            ),
             false => Saved::Cells(self.cells.coords().to_vec()),
         }
     }
@@ -493,10 +508,22 @@ impl<const D: usize> Neighbours<D> {
         t.is_finite().then_some(t)
     }
 
-    /// Whether particle `p` (number `i`) is within half a skin of its centre at `t` (a saved
-    /// state must be).
+    /// Whether particle `p` (number `i`) is where its bookkeeping says at `t` (a saved
+    /// state must be): within half a skin of its centre with lists; following, in its cell
+    /// (up to 10⁻⁹ of a cell width, the rounding of a crossing's position). Anything else
+    /// would hide neighbours from its searches.
     pub fn inside(&self, i: usize, p: &Particle<D>, t: f64) -> bool {
-        !self.listed() || (p.position_at(t) - self.centres[i]).norm_squared() <= self.bound2
+        if self.listed() {
+            return (p.position_at(t) - self.centres[i]).norm_squared() <= self.bound2;
+        }
+        let (r, m, counts) = (p.position_at(t), self.cells.coord(i), self.cells.counts());
+        (0..D).all(|a| {
+            let w = self.cells.width(a);
+            let slack = 1e-9 * w;
+            let within = r[a] >= m[a] as f64 * w - slack && r[a] <= (m[a] + 1) as f64 * w + slack;
+            let on_grid = self.sim_box.boundary[a] == Boundary::Periodic || (0..counts[a] as i64).contains(&m[a]);
+            within && on_grid
+        })
     }
 
     /// Writes particle `i`'s neighbours but `skip` into `out` and returns how many: its

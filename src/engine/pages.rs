@@ -22,7 +22,7 @@ const FROM_BYTES: usize = 4 << 20;
 const HUGE: usize = 2 << 20;
 
 /// `items` in a new vector whose memory was advised to be backed by huge pages before it
-/// was written (when it is at least [`FROM_BYTES`]; else an ordinary vector).
+/// was written (when it is at least `FROM_BYTES`; else an ordinary vector).
 pub fn collect<T>(items: impl ExactSizeIterator<Item = T>) -> Vec<T> {
     let mut v = Vec::with_capacity(items.len());
     advise(&v);

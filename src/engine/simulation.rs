@@ -56,9 +56,12 @@ pub enum Outcome<const D: usize> {
         /// |Δp| = 2m|v⊥|.
         impulse: f64,
     },
-    /// A particle's neighbourhood was updated: it left its skin and its list was rebuilt,
+    /// Particle `i`'s neighbourhood was updated: it left its skin and its list was rebuilt,
     /// or (with the grid) it crossed into the next cell. Bookkeeping only.
-    Rebuild,
+    Rebuild {
+        /// The particle.
+        i: usize,
+    },
     /// A scheduled sampling time was reached.
     Sample,
 }
@@ -119,8 +122,10 @@ pub enum SetupError {
         axis: usize,
         /// Its length.
         length: f64,
-        /// The smallest length allowed.
+        /// The smallest length allowed (between walls, the edge must be longer).
         minimum: f64,
+        /// Whether the axis has walls.
+        walls: bool,
     },
     /// A particle outside the walls.
     OutsideBox {
@@ -160,13 +165,19 @@ impl fmt::Display for SetupError {
                 write!(
                     f,
                     "particle {index}: {field} = {value} (must be finite{})",
-                    if *field == "position" { "" } else { " and > 0" }
+                    if matches!(*field, "radius" | "mass") { " and > 0" } else { "" }
                 )
             }
-            SetupError::BoxTooSmall { axis, length, minimum } => {
+            SetupError::BoxTooSmall { axis, length, minimum, walls: false } => {
                 write!(
                     f,
-                    "box edge {axis} = {length} is too short: it must be at least {minimum} (two contact distances when periodic, one diameter between walls)"
+                    "box edge {axis} = {length} is too short: a periodic edge must be at least {minimum} (two largest contact distances, so that a disk meets one image of another)"
+                )
+            }
+            SetupError::BoxTooSmall { axis, length, minimum, walls: true } => {
+                write!(
+                    f,
+                    "box edge {axis} = {length} is too short: between walls it must be longer than the largest diameter {minimum}"
                 )
             }
             SetupError::OutsideBox { index, axis, coordinate } => {
@@ -202,6 +213,9 @@ const HITS: usize = 32;
 /// The most particles a simulation takes: indices are 32-bit, and the event queue pads the
 /// particles with up to two empty slots.
 pub const MAX_PARTICLES: usize = u32::MAX as usize - 4;
+
+/// The largest overlap a saved state may hold (a fraction of the contact distance).
+pub const RESTORE_OVERLAP: f64 = 1e-9;
 
 /// Neighbours gathered per prediction for the batch search (more: the scalar search).
 const NEAR: usize = 64;
@@ -266,6 +280,10 @@ pub struct SimulationState<const D: usize> {
     /// empty).
     #[serde(default)]
     pub centres: Vec<Vec<f64>>,
+    /// With lists: the crowded particles (more neighbours in range than a list holds, when
+    /// their list was last built), in increasing order.
+    #[serde(default)]
+    pub crowded: Vec<u32>,
     /// The neighbourhood asked for.
     #[serde(default)]
     pub neighbourhood: Neighbourhood,
@@ -319,24 +337,7 @@ impl<const D: usize> Simulation<D> {
             lookahead: lookahead_pays(n),
         };
         sim.batch = !sim.short.contains(&true);
-        if let Some(audit) = sim.overlap_beyond(0.0) {
-            let (i, j) = audit.at.expect("an overlap has a place");
-            if i == j {
-                let p = &sim.particles[i];
-                let axis = (0..D).find(|&a| {
-                    sim.sim_box.boundary[a] == Boundary::Wall && {
-                        let x = p.position[a];
-                        x < p.radius || x > sim.sim_box.lengths[a] - p.radius
-                    }
-                });
-                return Err(SetupError::OutsideBox {
-                    index: i,
-                    axis: axis.unwrap_or(0),
-                    coordinate: p.position[axis.unwrap_or(0)],
-                });
-            }
-            return Err(SetupError::Overlap { i, j, fraction: audit.fraction });
-        }
+        sim.refuse_overlaps(0.0)?;
         sim.predict_everyone();
         Ok(sim)
     }
@@ -352,20 +353,40 @@ impl<const D: usize> Simulation<D> {
         if state.pending.len() != n {
             return bad(format!("{} pending events for {n} particles", state.pending.len()));
         }
+        if !state.time.is_finite() {
+            return bad(format!("the clock is {}", state.time));
+        }
+        if let Some((i, p)) = state.particles.iter().enumerate().find(|(_, p)| p.time > state.time) {
+            return bad(format!("particle {i} was last updated at {}, after the clock ({})", p.time, state.time));
+        }
         for (owner, p) in state.pending.iter().enumerate() {
             let fine = match p.kind {
                 PendingKind::Pair { partner, .. } => (partner as usize) < n && partner as usize != owner,
-                PendingKind::Wall { axis, .. } => (axis as usize) < D,
+                PendingKind::Wall { axis, .. } => {
+                    (axis as usize) < D && sim_box.boundary[axis as usize] == Boundary::Wall
+                }
                 PendingKind::Rebuild | PendingKind::Nothing => true,
             };
-            if !fine || p.time.is_nan() {
-                return bad(format!("pending event {owner} is {p:?}"));
+            // Every pending event is predicted no earlier than the clock at its prediction,
+            // and the clock is the time of the earliest: none is ever in the past.
+            if !fine || p.time.is_nan() || p.time < state.time {
+                return bad(format!("pending event {owner} is {p:?} (the clock is at {})", state.time));
+            }
+        }
+        match (state.sampling, state.next_sample) {
+            (None, None) => {}
+            (Some(dt), Some(next)) if dt.is_finite() && dt > 0.0 && next >= state.time && next.is_finite() => {}
+            (sampling, next) => {
+                return bad(format!("sampling every {sampling:?}, next at {next:?}, with the clock at {}", state.time));
             }
         }
         let saved = if state.centres.is_empty() {
+            if !state.crowded.is_empty() {
+                return bad("crowded particles without neighbour lists".into());
+            }
             Saved::Cells(state.cells.iter().map(|c| std::array::from_fn(|a| c[a])).collect())
         } else {
-            Saved::Centres(state.centres.iter().map(|c| SVector::from_column_slice(c)).collect())
+            Saved::Centres(state.centres.iter().map(|c| SVector::from_column_slice(c)).collect(), state.crowded)
         };
         let short = short_axes(&sim_box, reach);
         let allow = !short.contains(&true);
@@ -375,10 +396,16 @@ impl<const D: usize> Simulation<D> {
         };
         for (i, p) in state.particles.iter().enumerate() {
             if !neighbours.inside(i, p, state.time) {
-                return bad(format!("particle {i} is outside its skin (centre {:?})", state.centres[i]));
+                return bad(match neighbours.listed() {
+                    true => format!(
+                        "particle {i} is outside its skin (centre {:?}) at time {}",
+                        state.centres[i], state.time
+                    ),
+                    false => format!("particle {i} is not in its cell {:?} at time {}", state.cells[i], state.time),
+                });
             }
         }
-        Ok(Simulation {
+        let sim = Simulation {
             neighbours,
             neighbourhood: state.neighbourhood,
             particles: pages::moved(state.particles),
@@ -393,19 +420,81 @@ impl<const D: usize> Simulation<D> {
             counts: state.counts,
             sampling: state.sampling,
             next_sample: state.next_sample,
-        })
+        };
+        // A saved state comes from a run whose contacts are exact to rounding: overlaps of
+        // some 10⁻¹³ of a contact distance occur, far below this tolerance; anything more was
+        // not written by a run.
+        sim.refuse_overlaps(RESTORE_OVERLAP)?;
+        sim.check_pending().map_err(|what| SetupError::BadState { what })?;
+        Ok(sim)
+    }
+
+    /// Checks that the pending events are what a run leaves: every live event is the
+    /// prediction its state gives (pairs and walls to the bit, a neighbourhood update to
+    /// rounding), and every event that can happen is covered — no particle's pending event
+    /// is later than its next wall or update, and every pair that will touch has one of its
+    /// two pending events no later than the contact. Re-prediction markers may be anything
+    /// after the clock. A state that fails would miss collisions, or make disks collide
+    /// apart.
+    fn check_pending(&self) -> Result<(), String> {
+        let now = self.time;
+        // An update's time depends on the clock it was predicted at, by rounding; the exit
+        // radius is 2⁻²⁰ of the skin inside it, far more than this.
+        let close = |a: f64, b: f64| (a - b).abs() <= 1e-12 * a.abs().max(b.abs()).max(1.0);
+        for i in 0..self.particles.len() {
+            let p = &self.particles[i];
+            let e = self.queue.get(i);
+            let wall = predict_wall(p, &self.sim_box).map(|(t, axis, upper)| (t.max(now), axis, upper));
+            let exit = self.neighbours.exit_time(i, p, now).map(|t| t.max(now));
+            let fine = match e.kind {
+                PendingKind::Pair { partner, partner_events }
+                    if self.particles[partner as usize].events == partner_events =>
+                {
+                    let q = &self.particles[partner as usize];
+                    predict_pair(p, q, &self.sim_box, now, &self.short).map(|t| t.max(now)) == Some(e.time)
+                }
+                PendingKind::Wall { axis, upper } => wall == Some((e.time, axis as usize, upper)),
+                PendingKind::Rebuild => exit.is_some_and(|x| close(x, e.time)),
+                _ => true,
+            };
+            if !fine {
+                return Err(format!("pending event {i} ({:?} at {}) is not what its state predicts", e.kind, e.time));
+            }
+            let late_for_wall = wall.is_some_and(|(t, ..)| e.time > t);
+            let late_for_update = exit.is_some_and(|x| e.time > x && !close(x, e.time));
+            if late_for_wall || late_for_update {
+                return Err(format!(
+                    "particle {i}'s pending event at {} is later than its next wall or update",
+                    e.time
+                ));
+            }
+            for j in self.neighbours.candidates(i).filter(|&j| j > i) {
+                let q = &self.particles[j];
+                if let Some(t) = predict_pair(p, q, &self.sim_box, now, &self.short).map(|t| t.max(now))
+                    && e.time.min(self.queue.get(j).time) > t
+                {
+                    return Err(format!(
+                        "particles {i} and {j} touch at {t}, and neither has an event pending by then"
+                    ));
+                }
+            }
+        }
+        Ok(())
     }
 
     /// The complete state, for checkpoints.
     pub fn state(&self) -> SimulationState<D> {
-        let (cells, centres) = match self.neighbours.save() {
-            Saved::Cells(coords) => (coords.iter().map(|m| m.to_vec()).collect(), Vec::new()),
-            Saved::Centres(centres) => (Vec::new(), centres.iter().map(|c| c.as_slice().to_vec()).collect()),
+        let (cells, centres, crowded) = match self.neighbours.save() {
+            Saved::Cells(coords) => (coords.iter().map(|m| m.to_vec()).collect(), Vec::new(), Vec::new()),
+            Saved::Centres(centres, crowded) => {
+                (Vec::new(), centres.iter().map(|c| c.as_slice().to_vec()).collect(), crowded)
+            }
         };
         SimulationState {
             particles: self.particles.clone(),
             cells,
             centres,
+            crowded,
             neighbourhood: self.neighbourhood,
             pending: self.queue.pending(),
             time: self.time,
@@ -506,6 +595,25 @@ impl<const D: usize> Simulation<D> {
     /// their contact distance) or of a particle beyond a wall (as a fraction of its diameter).
     pub fn check_overlaps(&self) -> OverlapAudit {
         self.overlap_beyond(f64::NEG_INFINITY).unwrap_or_default()
+    }
+
+    /// An error for the largest overlap beyond `threshold` (a fraction of the contact
+    /// distance, or of the diameter beyond a wall), if there is one.
+    fn refuse_overlaps(&self, threshold: f64) -> Result<(), SetupError> {
+        let Some(audit) = self.overlap_beyond(threshold) else { return Ok(()) };
+        let (i, j) = audit.at.expect("an overlap has a place");
+        if i != j {
+            return Err(SetupError::Overlap { i, j, fraction: audit.fraction });
+        }
+        let p = &self.particles[i];
+        let r = p.position_at(self.time);
+        let axis = (0..D)
+            .find(|&a| {
+                self.sim_box.boundary[a] == Boundary::Wall
+                    && (r[a] < p.radius || r[a] > self.sim_box.lengths[a] - p.radius)
+            })
+            .unwrap_or(0);
+        Err(SetupError::OutsideBox { index: i, axis, coordinate: r[axis] })
     }
 
     /// The largest overlap if it exceeds `threshold` (a fraction).
@@ -846,7 +954,7 @@ impl<const D: usize> Simulation<D> {
                     self.neighbours.rebuild(owner, &self.particles[owner], t);
                     // Same velocity, new neighbours: predict again over the new list.
                     self.predict_alone(owner);
-                    return Some(Outcome::Rebuild);
+                    return Some(Outcome::Rebuild { i: owner });
                 }
             }
         }
@@ -917,26 +1025,43 @@ fn validate<const D: usize>(particles: &[Particle<D>], sim_box: &SimBox<D>) -> R
                 return Err(SetupError::BadParticle { index, field, value });
             }
         }
-        for x in p.position.iter().chain(p.velocity.iter()).chain([p.time].iter()) {
-            if !x.is_finite() {
-                return Err(SetupError::BadParticle { index, field: "position", value: *x });
+        for (field, values) in [("position", p.position.as_slice()), ("velocity", p.velocity.as_slice())] {
+            if let Some(&value) = values.iter().find(|x| !x.is_finite()) {
+                return Err(SetupError::BadParticle { index, field, value });
             }
+        }
+        if !p.time.is_finite() {
+            return Err(SetupError::BadParticle { index, field: "time", value: p.time });
+        }
+        // The energy must be a number: m|v|² overflowing makes every temperature and
+        // pressure infinite (and such a speed crosses the box in less than the clock's
+        // resolution).
+        let energy = p.kinetic_energy();
+        if !energy.is_finite() {
+            return Err(SetupError::BadParticle { index, field: "kinetic energy", value: energy });
         }
         rmax = rmax.max(p.radius);
     }
     let reach = 2.0 * rmax;
+    check_box(sim_box, reach)?;
+    Ok(reach)
+}
+
+/// Checks that a box can hold particles of contact distance up to `reach` (twice the
+/// largest radius): every edge finite, a periodic edge at least `2·reach` (minimum image:
+/// a particle then meets at most one image of another), an edge between walls longer than
+/// `reach` (a particle exactly as wide as the gap touches both walls at once and bounces
+/// between them without the clock moving).
+pub fn check_box<const D: usize>(sim_box: &SimBox<D>, reach: f64) -> Result<(), SetupError> {
     for a in 0..D {
-        let minimum = match sim_box.boundary[a] {
-            // Minimum image needs L > 2·reach: a disk then meets at most one image of another.
-            Boundary::Periodic => 2.0 * reach,
-            Boundary::Wall => reach,
-        };
         let length = sim_box.lengths[a];
-        if !(length.is_finite() && length >= minimum) {
-            return Err(SetupError::BoxTooSmall { axis: a, length, minimum });
+        let walls = sim_box.boundary[a] == Boundary::Wall;
+        let (fits, minimum) = if walls { (length > reach, reach) } else { (length >= 2.0 * reach, 2.0 * reach) };
+        if !(length.is_finite() && fits) {
+            return Err(SetupError::BoxTooSmall { axis: a, length, minimum, walls });
         }
     }
-    Ok(reach)
+    Ok(())
 }
 
 #[cfg(test)]
@@ -1027,7 +1152,7 @@ mod tests {
             let mut sim = Simulation::with_neighbourhood(one, moving.sim_box, neighbourhood).expect("valid");
             let first = loop {
                 match sim.step() {
-                    Some(Outcome::Rebuild) => continue,
+                    Some(Outcome::Rebuild { .. }) => continue,
                     other => break other,
                 }
             };

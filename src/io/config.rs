@@ -1,10 +1,12 @@
 //! The run configuration (TOML): parsing, defaults, validation.
 //!
-//! Unknown keys are errors (they are usually typos). Every validation error names the file,
-//! the field and the value, and says what is allowed.
+//! Unknown keys are errors (they are usually typos), in every table. Every validation error
+//! names the file, the field (or the line and column of a syntax error) and the value —
+//! cut short when it is long ([`crate::io::text`]) — and says what is allowed.
 
 use crate::engine::Boundary;
 use crate::engine::init::{Placement, Species, Velocities};
+use crate::io::text::{line_column, num, shorten};
 use serde::{Deserialize, Serialize};
 use std::fmt;
 use std::path::Path;
@@ -61,13 +63,53 @@ pub struct Config {
 }
 
 /// Boundaries: one for all axes, or one per axis.
-#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[derive(Clone, Debug, PartialEq, Serialize)]
 #[serde(untagged)]
 pub enum Boundaries {
     /// The same on every axis.
     All(Boundary),
     /// One per axis.
     PerAxis(Vec<Boundary>),
+}
+
+impl<'de> Deserialize<'de> for Boundaries {
+    fn deserialize<D: serde::Deserializer<'de>>(deserializer: D) -> Result<Self, D::Error> {
+        use serde::de::{self, SeqAccess, Visitor};
+        const ALLOWED: &str = r#""periodic" or "wall", or one per axis such as ["periodic", "wall"]"#;
+        fn named<E: de::Error>(name: &str) -> Result<Boundary, E> {
+            match name {
+                "periodic" => Ok(Boundary::Periodic),
+                "wall" => Ok(Boundary::Wall),
+                other => Err(E::custom(format!(
+                    "box.boundary: \"{}\" is not a boundary; expected {ALLOWED}",
+                    crate::io::text::excerpt(other)
+                ))),
+            }
+        }
+        struct Either;
+        impl<'de> Visitor<'de> for Either {
+            type Value = Boundaries;
+            fn expecting(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+                f.write_str(ALLOWED)
+            }
+            fn visit_str<E: de::Error>(self, v: &str) -> Result<Boundaries, E> {
+                named(v).map(Boundaries::All)
+            }
+            fn visit_seq<A: SeqAccess<'de>>(self, mut seq: A) -> Result<Boundaries, A::Error> {
+                let mut axes = Vec::new();
+                while let Some(name) = seq.next_element::<String>()? {
+                    axes.push(named(&name)?);
+                    if axes.len() > 3 {
+                        return Err(de::Error::custom(format!(
+                            "box.boundary has more than 3 entries; expected {ALLOWED}"
+                        )));
+                    }
+                }
+                Ok(Boundaries::PerAxis(axes))
+            }
+        }
+        deserializer.deserialize_any(Either)
+    }
 }
 
 /// The box: either its size or the packing fraction (N comes from the species).
@@ -142,9 +184,10 @@ fn default_blocks() -> usize {
 #[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct OutputConfig {
-    /// Write a trajectory frame every this many samples (0 or absent: none).
+    /// Write a trajectory frame every this many samples (absent: no trajectory).
     pub trajectory_every: Option<u64>,
-    /// Write a checkpoint every this many production pair collisions (0 or absent: none).
+    /// Write a checkpoint every this many production pair collisions (absent: only the
+    /// final one, which every run writes).
     pub checkpoint_every: Option<u64>,
 }
 
@@ -165,20 +208,40 @@ impl fmt::Display for ConfigError {
 
 impl std::error::Error for ConfigError {}
 
+/// The largest configuration file read (a configuration is a few hundred bytes).
+pub const MAX_FILE_BYTES: u64 = 1 << 24;
+
 impl Config {
-    /// Parses and validates TOML text; `source` names it in errors.
+    /// Parses and validates TOML text; `source` names it in errors. A syntax error or an
+    /// unknown key is reported with its line and column.
     pub fn parse(text: &str, source: &str) -> Result<Config, ConfigError> {
-        let err = |message: String| ConfigError { source: source.to_string(), message };
-        let config: Config = toml::from_str(text).map_err(|e| err(e.to_string().trim_end().replace('\n', " ")))?;
-        config.validate().map_err(err)?;
+        let err = |message: String| ConfigError { source: source.to_string(), message: shorten(&message) };
+        let config: Config = toml::from_str(text).map_err(|e| {
+            let at = e.span().map(|span| line_column(text, span.start));
+            err(match at {
+                Some((line, column)) => format!("TOML parse error at line {line}, column {column}: {}", e.message()),
+                None => format!("TOML parse error: {}", e.message()),
+            })
+        })?;
+        config.check().map_err(err)?;
         Ok(config)
     }
 
     /// Reads, parses and validates a file.
     pub fn load(path: &Path) -> Result<Config, ConfigError> {
         let source = path.display().to_string();
-        let text = std::fs::read_to_string(path)
-            .map_err(|e| ConfigError { source: source.clone(), message: format!("cannot read the file: {e}") })?;
+        let fail = |message: String| ConfigError { source: source.clone(), message };
+        let size = std::fs::metadata(path).map_err(|e| fail(format!("cannot read the file: {e}")))?.len();
+        if size > MAX_FILE_BYTES {
+            return Err(fail(format!(
+                "the file holds {size} bytes, more than a configuration can ({MAX_FILE_BYTES}); is it the right file?"
+            )));
+        }
+        let bytes = std::fs::read(path).map_err(|e| fail(format!("cannot read the file: {e}")))?;
+        let text = String::from_utf8(bytes).map_err(|e| {
+            let (line, column) = line_column(&String::from_utf8_lossy(e.as_bytes()), e.utf8_error().valid_up_to());
+            fail(format!("line {line}, column {column}: not valid UTF-8 (TOML files are UTF-8 text)"))
+        })?;
         Config::parse(&text, &source)
     }
 
@@ -195,17 +258,20 @@ impl Config {
         }
     }
 
-    /// Total number of particles.
+    /// Total number of particles (saturating: [`check`](Self::check) refuses more than
+    /// `usize::MAX`).
     pub fn n_particles(&self) -> usize {
-        self.species.iter().map(|s| s.count).sum()
+        self.species.iter().fold(0usize, |n, s| n.saturating_add(s.count))
     }
 
-    fn validate(&self) -> Result<(), String> {
+    /// Validates every value, as [`parse`](Self::parse) does: a configuration built or
+    /// edited in memory, or carried by a checkpoint, is checked exactly like a file.
+    pub fn check(&self) -> Result<(), String> {
         let positive = |name: &str, x: f64| {
             if x.is_finite() && x > 0.0 {
                 Ok(())
             } else {
-                Err(format!("{name} = {x}: must be a positive finite number"))
+                Err(format!("{name} = {}: must be a positive finite number", num(x)))
             }
         };
         if let Boundaries::PerAxis(v) = &self.sim_box.boundary
@@ -228,13 +294,20 @@ impl Config {
                 // Close packing of equal disks: π/(2√3) ≈ 0.9069.
                 if !(eta.is_finite() && eta > 0.0 && eta < 0.9069) {
                     return Err(format!(
-                        "box.packing_fraction = {eta}: must lie in (0, 0.9069) (close packing is π/(2√3))"
+                        "box.packing_fraction = {}: must lie in (0, 0.9069) (close packing is π/(2√3))",
+                        num(eta)
                     ));
                 }
             }
         }
         if let Some(aspect) = self.sim_box.aspect {
             positive("box.aspect", aspect)?;
+            if self.sim_box.size.is_some() {
+                return Err(format!(
+                    "box.aspect = {} is used only with packing_fraction; with size = [Lx, Ly] the aspect is Ly/Lx (remove one of them)",
+                    num(aspect)
+                ));
+            }
         }
         if self.species.is_empty() {
             return Err("species: give at least one [[species]] with count, radius and mass".into());
@@ -246,7 +319,28 @@ impl Config {
             positive(&format!("species[{k}].radius"), s.radius)?;
             positive(&format!("species[{k}].mass"), s.mass)?;
         }
+        if self.species.iter().try_fold(0usize, |n, s| n.checked_add(s.count)).is_none() {
+            return Err("species: the counts add up to more than 2⁶⁴ particles".into());
+        }
         positive("init.kT", self.init.kt)?;
+        for (k, s) in self.species.iter().enumerate() {
+            // The thermal speed √(2kT/m) must be a number, and so must the total energy ~N·kT.
+            let speed2 = 2.0 * self.init.kt / s.mass;
+            if !(speed2.is_finite() && speed2 > 0.0) {
+                return Err(format!(
+                    "init.kT = {} with species[{k}].mass = {}: the thermal speed √(2kT/m) is out of the f64 range",
+                    num(self.init.kt),
+                    num(s.mass)
+                ));
+            }
+        }
+        if !(self.init.kt * self.n_particles() as f64).is_finite() {
+            return Err(format!(
+                "init.kT = {} with {} particles: the total kinetic energy overflows",
+                num(self.init.kt),
+                self.n_particles()
+            ));
+        }
         if self.run.collisions.is_none() && self.run.time.is_none() {
             return Err("run: give collisions and/or time (the run stops at whichever comes first)".into());
         }
@@ -259,19 +353,23 @@ impl Config {
         if let Some(t) = self.equilibration.time
             && !(t.is_finite() && t >= 0.0)
         {
-            return Err(format!("equilibration.time = {t}: must be a finite number ≥ 0"));
+            return Err(format!("equilibration.time = {}: must be a finite number ≥ 0", num(t)));
         }
+        // How many samples that makes is checked with the other limits of a run
+        // (`run::limits`), which also estimate it when the run is given in collisions.
         positive("run.sample_interval", self.run.sample_interval)?;
-        if let Some(t) = self.run.time
-            && t / self.run.sample_interval > 1e8
-        {
-            return Err(format!(
-                "run.sample_interval = {}: with run.time = {t} that is more than 10⁸ samples; use a larger interval",
-                self.run.sample_interval
-            ));
-        }
         if self.run.blocks < 2 {
             return Err(format!("run.blocks = {}: must be at least 2 (error bars need two blocks)", self.run.blocks));
+        }
+        for (name, every) in
+            [("trajectory_every", self.output.trajectory_every), ("checkpoint_every", self.output.checkpoint_every)]
+        {
+            if every == Some(0) {
+                return Err(format!(
+                    "output.{name} = 0: must be at least 1 (leave it out for {})",
+                    if name == "trajectory_every" { "no trajectory" } else { "only the final checkpoint" }
+                ));
+            }
         }
         Ok(())
     }
@@ -314,7 +412,5 @@ mod tests {
         let typo = error_of("placement = \"triangular\"", "placement = \"hexagonal\"");
         assert!(typo.contains("hexagonal"), "{typo}");
         assert!(Config::parse("this is not toml", "x.toml").unwrap_err().to_string().starts_with("x.toml: "));
-        let flood = error_of("sample_interval = 1.0", "sample_interval = 1e-12\ntime = 10.0");
-        assert!(flood.contains("more than 10⁸ samples"), "{flood}");
     }
 }

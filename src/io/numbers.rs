@@ -68,8 +68,12 @@ pub fn parse_json(value: &Value) -> Result<f64, NumberError> {
 }
 
 /// Formats `x` as a JSON value's text: a bare number (shortest round-trip) or a quoted hex
-/// string.
+/// string; `±∞` (an overflowing root or time) as the string `"inf"` or `"-inf"`, in either
+/// format, since JSON has no infinity (`NaN` never arises: inputs are finite).
 pub fn format_json(x: f64, format: NumberFormat) -> String {
+    if x.is_infinite() {
+        return if x > 0.0 { "\"inf\"".to_string() } else { "\"-inf\"".to_string() };
+    }
     match format {
         NumberFormat::Shortest => format_plain(x),
         NumberFormat::Hex => format!("\"{}\"", quadratic::hex::format(x)),
@@ -87,7 +91,7 @@ pub fn format_text(x: f64, format: NumberFormat) -> String {
 fn format_plain(x: f64) -> String {
     match serde_json::Number::from_f64(x) {
         Some(n) => n.to_string(),
-        None => x.to_string(), // ±inf (an overflowing root): not valid JSON, but never silent
+        None => x.to_string(), // ±inf in plain text (JSON output never comes here)
     }
 }
 

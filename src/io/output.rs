@@ -1,43 +1,21 @@
-//! Writing a run's results: `summary.json`, `timeseries.csv`, `trajectory.xyz` (extended
-//! XYZ), `checkpoint.json`. Every file is written to a temporary name in the same directory
-//! and renamed into place, so a reader never sees half a file.
+//! A run's files and how `collide run` writes them: `summary.json`, `timeseries.csv`,
+//! `trajectory.xyz` (extended XYZ), `checkpoint.json`, in a directory that holds one run
+//! ([`crate::io::rundir`]: the policy, the lock, the atomic writes).
+//!
+//! [`Writer`] is the [`Sink`] of a run: it appends a trajectory frame every
+//! `trajectory_every` samples and writes a checkpoint every `checkpoint_every` production
+//! collisions. When the run ends — complete, interrupted or stopped — `finish` flushes the
+//! trajectory, writes the final checkpoint (not for a stalled run, whose state would stall
+//! again), the time series and, last, the summary.
 
 use crate::engine::{Boundary, Outcome, Simulation};
-use crate::run::{Checkpoint, Run, RunError, Summary};
+use crate::io::config::Config;
+pub use crate::io::rundir::{OutputError, write_atomic};
+use crate::io::rundir::{RunDir, Trajectory};
+use crate::run::{Checkpoint, Phase, Run, RunError, Sink, Status, Summary};
 use std::fmt::Write as _;
-use std::fs;
-use std::io::{self, Write};
-use std::path::{Path, PathBuf};
-use std::time::Instant;
-
-/// A failed output operation, with the path involved.
-#[derive(Debug)]
-pub struct OutputError {
-    /// The file or directory.
-    pub path: PathBuf,
-    /// What went wrong.
-    pub error: io::Error,
-}
-
-impl std::fmt::Display for OutputError {
-    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        write!(f, "{}: {}", self.path.display(), self.error)
-    }
-}
-
-impl std::error::Error for OutputError {}
-
-fn at(path: &Path) -> impl FnOnce(io::Error) -> OutputError + '_ {
-    move |error| OutputError { path: path.to_path_buf(), error }
-}
-
-/// Writes `contents` to `path` atomically (temporary file in the same directory, then rename).
-pub fn write_atomic(path: &Path, contents: &[u8]) -> Result<(), OutputError> {
-    let name = path.file_name().map(|n| n.to_string_lossy().into_owned()).unwrap_or_default();
-    let tmp = path.with_file_name(format!(".{name}.tmp"));
-    fs::write(&tmp, contents).map_err(at(&tmp))?;
-    fs::rename(&tmp, path).map_err(at(path))
-}
+use std::path::Path;
+use std::sync::atomic::AtomicBool;
 
 /// The time series as CSV: one row per sample.
 pub fn timeseries_csv(run: &Run) -> String {
@@ -58,8 +36,28 @@ pub fn timeseries_csv(run: &Run) -> String {
     out
 }
 
-/// One extended-XYZ frame (OVITO and ASE read it): 2D positions written with z = 0, every
-/// disk as element `X` with its radius and species index (`type`) in their own columns.
+/// The chemical symbols by atomic number, from 1: species `k` is written as element `k + 1`
+/// (`H`, `He`, `Li`, …), so that OVITO shows each species as its own particle type and ASE
+/// reads the names as symbols it knows.
+const ELEMENTS: [&str; 118] = [
+    "H", "He", "Li", "Be", "B", "C", "N", "O", "F", "Ne", "Na", "Mg", "Al", "Si", "P", "S", "Cl", "Ar", "K", "Ca",
+    "Sc", "Ti", "V", "Cr", "Mn", "Fe", "Co", "Ni", "Cu", "Zn", "Ga", "Ge", "As", "Se", "Br", "Kr", "Rb", "Sr", "Y",
+    "Zr", "Nb", "Mo", "Tc", "Ru", "Rh", "Pd", "Ag", "Cd", "In", "Sn", "Sb", "Te", "I", "Xe", "Cs", "Ba", "La", "Ce",
+    "Pr", "Nd", "Pm", "Sm", "Eu", "Gd", "Tb", "Dy", "Ho", "Er", "Tm", "Yb", "Lu", "Hf", "Ta", "W", "Re", "Os", "Ir",
+    "Pt", "Au", "Hg", "Tl", "Pb", "Bi", "Po", "At", "Rn", "Fr", "Ra", "Ac", "Th", "Pa", "U", "Np", "Pu", "Am", "Cm",
+    "Bk", "Cf", "Es", "Fm", "Md", "No", "Lr", "Rf", "Db", "Sg", "Bh", "Hs", "Mt", "Ds", "Rg", "Cn", "Nh", "Fl", "Mc",
+    "Lv", "Ts", "Og",
+];
+
+/// The symbol species `k` is written as (`X`, the dummy element, past the 118th).
+pub fn species_symbol(k: u32) -> &'static str {
+    ELEMENTS.get(k as usize).copied().unwrap_or("X")
+}
+
+/// One extended-XYZ frame (OVITO and ASE read it): 2D positions written with z = 0; the
+/// `species` column names each species by a chemical symbol ([`species_symbol`]: OVITO
+/// makes it the particle type, ASE the symbols), then the radius and the species index
+/// (`species_index`, a column of its own that neither reads as a type).
 pub fn xyz_frame(sim: &Simulation<2>) -> String {
     let b = sim.sim_box();
     let pbc = |a: usize| if b.boundary[a] == Boundary::Periodic { "T" } else { "F" };
@@ -67,7 +65,7 @@ pub fn xyz_frame(sim: &Simulation<2>) -> String {
     writeln!(out, "{}", sim.particles().len()).unwrap();
     writeln!(
         out,
-        "Lattice=\"{} 0.0 0.0 0.0 {} 0.0 0.0 0.0 1.0\" Properties=species:S:1:pos:R:3:radius:R:1:type:I:1 Time={} pbc=\"{} {} F\"",
+        "Lattice=\"{} 0.0 0.0 0.0 {} 0.0 0.0 0.0 1.0\" Properties=species:S:1:pos:R:3:radius:R:1:species_index:I:1 Time={} pbc=\"{} {} F\"",
         b.lengths[0],
         b.lengths[1],
         sim.time(),
@@ -76,84 +74,82 @@ pub fn xyz_frame(sim: &Simulation<2>) -> String {
     )
     .unwrap();
     for (p, r) in sim.particles().iter().zip(sim.wrapped_positions()) {
-        writeln!(out, "X {} {} 0.0 {} {}", r[0], r[1], p.radius, p.species).unwrap();
+        writeln!(out, "{} {} {} 0.0 {} {}", species_symbol(p.species), r[0], r[1], p.radius, p.species).unwrap();
     }
     out
 }
 
-/// Reads a checkpoint file.
+/// Reads a checkpoint file (verified: see [`Checkpoint::load`]); errors name the file.
 pub fn load_checkpoint(path: &Path) -> Result<Checkpoint, String> {
-    let text = fs::read_to_string(path).map_err(|e| format!("{}: cannot read the checkpoint: {e}", path.display()))?;
-    serde_json::from_str(&text).map_err(|e| format!("{}: not a collide checkpoint ({e})", path.display()))
+    Checkpoint::load(path).map_err(|e| format!("{}: {e}", path.display()))
 }
 
-/// Runs the production part of `run` to its end, writing every output into `dir`.
-/// `progress` is called about every 10⁴ events with the fraction done.
-pub fn execute(run: &mut Run, dir: &Path, mut progress: impl FnMut(f64)) -> Result<Summary, OutputError> {
-    fs::create_dir_all(dir).map_err(at(dir))?;
-    let trajectory_every = run.config.output.trajectory_every.unwrap_or(0);
-    let checkpoint_every = run.config.output.checkpoint_every.unwrap_or(0);
-    let trajectory_path = dir.join("trajectory.xyz");
-    let trajectory_tmp = dir.join(".trajectory.xyz.tmp");
-    let mut trajectory = if trajectory_every > 0 {
-        let file = fs::File::create(&trajectory_tmp).map_err(at(&trajectory_tmp))?;
-        Some(io::BufWriter::new(file))
-    } else {
-        None
-    };
-    let started = Instant::now();
-    let mut next_checkpoint =
-        if checkpoint_every > 0 { (run.collisions() / checkpoint_every + 1) * checkpoint_every } else { u64::MAX };
-    let mut steps = 0u64;
-    while !run.done() {
-        let Some(outcome) = run.step() else { break };
-        steps += 1;
-        if steps % 10_000 == 0 {
-            progress(run.progress());
+/// The [`Sink`] of `collide run`: the trajectory and the checkpoints, while the run goes.
+pub struct Writer<'a, P: FnMut(Phase, f64)> {
+    dir: &'a RunDir,
+    stop: &'a AtomicBool,
+    interrupt_after: Option<u64>,
+    trajectory: Option<Trajectory>,
+    trajectory_every: u64,
+    checkpoint_every: u64,
+    next_checkpoint: u64,
+    progress: P,
+}
+
+impl<P: FnMut(Phase, f64)> Writer<'_, P> {
+    /// The trajectory's length now, flushed to the disk (0 without one).
+    fn flush(&mut self) -> Result<u64, OutputError> {
+        self.trajectory.as_mut().map_or(Ok(0), Trajectory::flush)
+    }
+}
+
+impl<P: FnMut(Phase, f64)> Sink for Writer<'_, P> {
+    type Error = OutputError;
+
+    fn event(&mut self, run: &Run, outcome: &Outcome<2>) -> Result<(), OutputError> {
+        if run.phase() != Phase::Production {
+            return Ok(());
         }
-        if let (Outcome::Sample, Some(w)) = (outcome, trajectory.as_mut())
-            && run.thermo.samples.len() as u64 % trajectory_every == 0
+        if let (Outcome::Sample, Some(t)) = (outcome, self.trajectory.as_mut())
+            && run.thermo.samples.len() as u64 % self.trajectory_every == 0
         {
-            w.write_all(xyz_frame(&run.sim).as_bytes()).map_err(at(&trajectory_tmp))?;
+            t.append(&xyz_frame(&run.sim))?;
         }
-        if run.collisions() >= next_checkpoint && !run.done() {
-            let text = serde_json::to_string(&run.checkpoint()).expect("a checkpoint serialises");
-            write_atomic(&dir.join("checkpoint.json"), text.as_bytes())?;
-            next_checkpoint += checkpoint_every;
+        if self.interrupt_after.is_some_and(|c| run.collisions() >= c) {
+            self.stop.store(true, std::sync::atomic::Ordering::Relaxed);
         }
+        if run.collisions() >= self.next_checkpoint && !run.done() {
+            let bytes = self.flush()?;
+            let checkpoint = run.checkpoint(bytes);
+            self.dir.write_with("checkpoint.json", |w| checkpoint.write_json(w))?;
+            self.next_checkpoint = self.next_checkpoint.saturating_add(self.checkpoint_every);
+        }
+        Ok(())
     }
-    progress(1.0);
-    let wall = started.elapsed().as_secs_f64();
-    if let Some(mut w) = trajectory {
-        w.flush().map_err(at(&trajectory_tmp))?;
-        drop(w);
-        fs::rename(&trajectory_tmp, &trajectory_path).map_err(at(&trajectory_path))?;
+
+    fn progress(&mut self, phase: Phase, done: f64) {
+        (self.progress)(phase, done);
     }
-    let summary = run.summary(wall);
-    write_atomic(&dir.join("timeseries.csv"), timeseries_csv(run).as_bytes())?;
-    let json = serde_json::to_string_pretty(&summary).expect("a summary serialises");
-    write_atomic(&dir.join("summary.json"), json.as_bytes())?;
-    Ok(summary)
 }
 
-/// Starts a run from a configuration: builds and validates the initial state (nothing is
-/// written if that fails), equilibrates, then [`execute`]s it.
-/// `equilibrating` and `running` report the fraction done of each phase.
-pub fn run_config(
-    config: crate::io::config::Config,
-    dir: &Path,
-    equilibrating: impl FnMut(f64),
-    running: impl FnMut(f64),
-) -> Result<Summary, RunFailure> {
-    let mut run = Run::new(config).map_err(RunFailure::Run)?;
-    run.equilibrate(equilibrating);
-    execute(&mut run, dir, running).map_err(RunFailure::Output)
+/// How `collide run` starts.
+pub enum Start<'a> {
+    /// From a configuration.
+    Fresh(Config),
+    /// From a checkpoint file, already read.
+    Resume {
+        /// The checkpoint.
+        checkpoint: Checkpoint,
+        /// Its file.
+        path: &'a Path,
+    },
 }
 
 /// Either a run that could not start, or an output that could not be written.
+#[non_exhaustive]
 #[derive(Debug)]
 pub enum RunFailure {
-    /// Bad initial state or checkpoint.
+    /// Bad configuration, initial state or checkpoint.
     Run(RunError),
     /// A file could not be written.
     Output(OutputError),
@@ -169,3 +165,88 @@ impl std::fmt::Display for RunFailure {
 }
 
 impl std::error::Error for RunFailure {}
+
+/// How `collide run` treats its output directory and when it stops early.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct RunOptions {
+    /// Replace an earlier run's files in the directory.
+    pub force: bool,
+    /// Stop as if interrupted once production has this many pair collisions (for tests of
+    /// interruption at a point known in advance).
+    pub interrupt_after: Option<u64>,
+}
+
+/// A run of `collide run`: sets it up (nothing is written if that fails), opens `dir`
+/// (refusing another run's files unless `options.force`), runs both phases until done,
+/// stopped by `stop` or by the watchdog, and writes every file. `progress` is told the
+/// phase and the fraction of it done now and then.
+pub fn run_into(
+    start: Start<'_>,
+    dir: &Path,
+    options: RunOptions,
+    stop: &AtomicBool,
+    progress: impl FnMut(Phase, f64),
+) -> Result<Summary, RunFailure> {
+    let force = options.force;
+    let mut warnings = Vec::new();
+    let (mut run, continuing, bytes) = match start {
+        Start::Fresh(config) => (Run::new(config).map_err(RunFailure::Run)?, None, 0),
+        Start::Resume { checkpoint, path } => {
+            let bytes = checkpoint.run.trajectory_bytes;
+            let run = Run::resume(checkpoint).map_err(RunFailure::Run)?;
+            let source = path.parent().map(|p| if p.as_os_str().is_empty() { Path::new(".") } else { p });
+            (run, Some(source.unwrap_or(Path::new(".")).to_path_buf()), bytes)
+        }
+    };
+    let out = RunDir::open(dir, force, continuing.as_deref()).map_err(RunFailure::Output)?;
+    let trajectory_every = run.config.output.trajectory_every.unwrap_or(0);
+    let trajectory = match (trajectory_every, &continuing) {
+        (0, _) => None,
+        (_, None) => Some(Trajectory::create(&out).map_err(RunFailure::Output)?),
+        (every, Some(source)) => {
+            let frames = run.thermo.samples.len() as u64 / every;
+            let n = run.sim.particles().len() as u64;
+            Some(
+                Trajectory::resume(&out, source, (bytes, frames, n), force, &mut warnings)
+                    .map_err(RunFailure::Output)?,
+            )
+        }
+    };
+    let checkpoint_every = run.config.output.checkpoint_every.unwrap_or(u64::MAX);
+    let next_checkpoint = (run.collisions() / checkpoint_every).saturating_add(1).saturating_mul(checkpoint_every);
+    let mut writer = Writer {
+        dir: &out,
+        stop,
+        interrupt_after: options.interrupt_after,
+        trajectory,
+        trajectory_every,
+        checkpoint_every,
+        next_checkpoint,
+        progress,
+    };
+    let status = run.advance(stop, &mut writer).map_err(RunFailure::Output)?;
+    finish(&run, &mut writer, status, warnings).map_err(RunFailure::Output)
+}
+
+/// Writes the files of a run that has ended with `status`: the trajectory flushed, the
+/// final checkpoint (not after a stall), the time series, and the summary last.
+fn finish<P: FnMut(Phase, f64)>(
+    run: &Run,
+    writer: &mut Writer<'_, P>,
+    status: Status,
+    warnings: Vec<String>,
+) -> Result<Summary, OutputError> {
+    (writer.progress)(run.phase(), 1.0);
+    let bytes = writer.flush()?;
+    let dir = writer.dir;
+    if status != Status::Stalled {
+        let checkpoint = run.checkpoint(bytes);
+        dir.write_with("checkpoint.json", |w| checkpoint.write_json(w))?;
+    }
+    dir.write("timeseries.csv", timeseries_csv(run).as_bytes())?;
+    let mut summary = run.summary();
+    summary.warnings.extend(warnings);
+    let json = serde_json::to_string_pretty(&summary).expect("a summary serialises");
+    dir.write("summary.json", json.as_bytes())?;
+    Ok(summary)
+}

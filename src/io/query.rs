@@ -8,15 +8,95 @@
 //!   `{"id": <same>, "t": <num or null>}` (`null` = never, `0` = now).
 //!
 //! `<num>` is a JSON number or a string holding a decimal or hex float, read exactly
-//! ([`crate::io::numbers`]). `id` is echoed verbatim (`null` if absent). A line that cannot
-//! be answered — malformed JSON, an unknown or missing key, a non-finite number, a negative
-//! radius — produces no output line and one message on the error stream naming its line
+//! ([`crate::io::numbers`]). An output number beyond the f64 range (a root or a time that
+//! overflows) is the string `"inf"` (or `"-inf"`): JSON has no infinity, and every line
+//! out is strict JSON. `id` is echoed verbatim, as its source text (`null` if absent).
+//!
+//! A line that cannot be answered — not UTF-8, longer than [`MAX_LINE`] bytes, malformed
+//! JSON, a duplicate, unknown or missing key, a non-finite number, a negative radius —
+//! produces no output line and one short message on the error stream naming its line
 //! number; every other line is still answered. Blank lines are skipped.
 
 use super::numbers::{NumberFormat, format_json, parse_json};
+use super::text::shorten;
 use quadratic::{Ball, Roots};
-use serde_json::{Map, Value};
+use serde_json::Value;
+use serde_json::value::RawValue;
 use std::io::{self, BufRead, Write};
+
+/// The longest input line answered, bytes (a request is a few hundred).
+pub const MAX_LINE: usize = 1 << 20;
+
+/// The keys of one request, each with its value's source text, in order; a key given twice
+/// is refused (JSON leaves duplicates undefined, and serde_json would keep the last).
+struct Fields<'a>(Vec<(String, &'a RawValue)>);
+
+impl<'de: 'a, 'a> serde::Deserialize<'de> for Fields<'a> {
+    fn deserialize<D: serde::Deserializer<'de>>(deserializer: D) -> Result<Self, D::Error> {
+        struct Object;
+        impl<'de> serde::de::Visitor<'de> for Object {
+            type Value = Fields<'de>;
+            fn expecting(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+                f.write_str("a JSON object")
+            }
+            fn visit_map<M: serde::de::MapAccess<'de>>(self, mut map: M) -> Result<Fields<'de>, M::Error> {
+                let mut fields: Vec<(String, &'de RawValue)> = Vec::new();
+                while let Some(key) = map.next_key::<String>()? {
+                    if fields.iter().any(|(k, _)| *k == key) {
+                        return Err(serde::de::Error::custom(format!("key '{key}' given twice")));
+                    }
+                    fields.push((key, map.next_value()?));
+                }
+                Ok(Fields(fields))
+            }
+        }
+        deserializer.deserialize_map(Object)
+    }
+}
+
+impl Fields<'_> {
+    fn raw(&self, key: &str) -> Option<&RawValue> {
+        self.0.iter().find(|(k, _)| k == key).map(|(_, v)| *v)
+    }
+
+    fn get(&self, key: &str) -> Result<Value, String> {
+        let raw = self.raw(key).ok_or_else(|| format!("missing key '{key}'"))?;
+        serde_json::from_str(raw.get()).map_err(|e| format!("{key}: {e}"))
+    }
+}
+
+/// Reads one line into `buf` (without its end), keeping at most `cap` bytes; returns the
+/// bytes read (0 at the end of the input) and whether the line was longer than `cap`.
+fn read_line<R: BufRead>(input: &mut R, buf: &mut Vec<u8>, cap: usize) -> io::Result<(usize, bool)> {
+    buf.clear();
+    let (mut read, mut long) = (0, false);
+    loop {
+        let chunk = match input.fill_buf() {
+            Ok(chunk) => chunk,
+            Err(e) if e.kind() == io::ErrorKind::Interrupted => continue,
+            Err(e) => return Err(e),
+        };
+        if chunk.is_empty() {
+            break;
+        }
+        let (take, end) = match chunk.iter().position(|&b| b == b'\n') {
+            Some(k) => (k + 1, true),
+            None => (chunk.len(), false),
+        };
+        let room = cap.saturating_sub(buf.len());
+        buf.extend_from_slice(&chunk[..take.min(room)]);
+        long |= take > room;
+        read += take;
+        input.consume(take);
+        if end {
+            break;
+        }
+    }
+    while buf.last().is_some_and(|&b| b == b'\n' || b == b'\r') {
+        buf.pop();
+    }
+    Ok((read, long))
+}
 
 /// Which query a JSON-lines stream carries.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -37,26 +117,27 @@ pub fn answer_lines<R: BufRead, W: Write, E: Write>(
     format: NumberFormat,
 ) -> io::Result<usize> {
     let mut failed = 0;
-    for (index, line) in input.lines().enumerate() {
-        let line = line?;
-        if line.trim().is_empty() {
-            continue;
+    let mut buf = Vec::new();
+    let mut input = input;
+    for index in 1.. {
+        let (read, long) = read_line(&mut input, &mut buf, MAX_LINE)?;
+        if read == 0 {
+            break;
         }
-        let answer = serde_json::from_str::<Value>(&line)
-            .map_err(|e| format!("not valid JSON ({e})"))
-            .and_then(|v| match v {
-                Value::Object(map) => Ok(map),
-                other => Err(format!("expected a JSON object, found {other}")),
-            })
-            .and_then(|map| match query {
-                Query::Roots => answer_roots(&map, format),
-                Query::ContactTime => answer_contact(&map, format),
-            });
+        let answer = if long {
+            Err(format!("longer than {MAX_LINE} bytes (a request is a few hundred)"))
+        } else {
+            match std::str::from_utf8(&buf) {
+                Err(e) => Err(format!("not valid UTF-8 (byte {})", e.valid_up_to() + 1)),
+                Ok(line) if line.trim().is_empty() => continue,
+                Ok(line) => answer_line(query, line, format),
+            }
+        };
         match answer {
             Ok(text) => writeln!(output, "{text}")?,
             Err(problem) => {
                 failed += 1;
-                writeln!(errors, "line {}: {problem}", index + 1)?;
+                writeln!(errors, "line {index}: {}", shorten(&problem))?;
             }
         }
     }
@@ -64,8 +145,16 @@ pub fn answer_lines<R: BufRead, W: Write, E: Write>(
     Ok(failed)
 }
 
-fn check_keys(map: &Map<String, Value>, allowed: &[&str]) -> Result<(), String> {
-    for key in map.keys() {
+fn answer_line(query: Query, line: &str, format: NumberFormat) -> Result<String, String> {
+    let fields: Fields = serde_json::from_str(line).map_err(|e| format!("not valid JSON ({e})"))?;
+    match query {
+        Query::Roots => answer_roots(&fields, format),
+        Query::ContactTime => answer_contact(&fields, format),
+    }
+}
+
+fn check_keys(fields: &Fields, allowed: &[&str]) -> Result<(), String> {
+    for (key, _) in &fields.0 {
         if !allowed.contains(&key.as_str()) {
             return Err(format!("unknown key '{key}' (allowed: {})", allowed.join(", ")));
         }
@@ -73,20 +162,20 @@ fn check_keys(map: &Map<String, Value>, allowed: &[&str]) -> Result<(), String> 
     Ok(())
 }
 
-fn number(map: &Map<String, Value>, key: &str) -> Result<f64, String> {
-    let value = map.get(key).ok_or_else(|| format!("missing key '{key}'"))?;
-    parse_json(value).map_err(|e| format!("{key}: {e}"))
+fn number(fields: &Fields, key: &str) -> Result<f64, String> {
+    parse_json(&fields.get(key)?).map_err(|e| format!("{key}: {e}"))
 }
 
-fn id_text(map: &Map<String, Value>) -> String {
-    map.get("id").map_or_else(|| "null".to_string(), Value::to_string)
+/// The id's source text, exactly as given (`null` if absent).
+fn id_text(fields: &Fields) -> String {
+    fields.raw("id").map_or_else(|| "null".to_string(), |raw| raw.get().trim().to_string())
 }
 
-fn answer_roots(map: &Map<String, Value>, format: NumberFormat) -> Result<String, String> {
-    check_keys(map, &["id", "a", "b", "c"])?;
-    let (a, b, c) = (number(map, "a")?, number(map, "b")?, number(map, "c")?);
+fn answer_roots(fields: &Fields, format: NumberFormat) -> Result<String, String> {
+    check_keys(fields, &["id", "a", "b", "c"])?;
+    let (a, b, c) = (number(fields, "a")?, number(fields, "b")?, number(fields, "c")?);
     let roots = quadratic::solve(a, b, c).map_err(|e| e.to_string())?;
-    let id = id_text(map);
+    let id = id_text(fields);
     Ok(match roots {
         Roots::All => format!("{{\"id\":{id},\"all\":true}}"),
         other => {
@@ -96,19 +185,21 @@ fn answer_roots(map: &Map<String, Value>, format: NumberFormat) -> Result<String
     })
 }
 
-fn vector(map: &Map<String, Value>, key: &str) -> Result<Vec<f64>, String> {
-    let value = map.get(key).ok_or_else(|| format!("missing key '{key}'"))?;
+fn vector(fields: &Fields, key: &str) -> Result<Vec<f64>, String> {
+    let value = fields.get(key)?;
     let items = value.as_array().ok_or_else(|| format!("{key}: expected an array like [x, y], found {value}"))?;
     items.iter().enumerate().map(|(i, v)| parse_json(v).map_err(|e| format!("{key}[{i}]: {e}"))).collect()
 }
 
-fn answer_contact(map: &Map<String, Value>, format: NumberFormat) -> Result<String, String> {
-    check_keys(map, &["id", "r1", "v1", "R1", "r2", "v2", "R2"])?;
-    let first = DynBall { position: vector(map, "r1")?, velocity: vector(map, "v1")?, radius: number(map, "R1")? };
-    let second = DynBall { position: vector(map, "r2")?, velocity: vector(map, "v2")?, radius: number(map, "R2")? };
+fn answer_contact(fields: &Fields, format: NumberFormat) -> Result<String, String> {
+    check_keys(fields, &["id", "r1", "v1", "R1", "r2", "v2", "R2"])?;
+    let first =
+        DynBall { position: vector(fields, "r1")?, velocity: vector(fields, "v1")?, radius: number(fields, "R1")? };
+    let second =
+        DynBall { position: vector(fields, "r2")?, velocity: vector(fields, "v2")?, radius: number(fields, "R2")? };
     let time = contact_time_dyn(&first, &second)?;
     let t = time.map_or_else(|| "null".to_string(), |t| format_json(t, format));
-    Ok(format!("{{\"id\":{},\"t\":{t}}}", id_text(map)))
+    Ok(format!("{{\"id\":{},\"t\":{t}}}", id_text(fields)))
 }
 
 /// A disk (or sphere) whose dimension is known only at run time.

@@ -77,8 +77,25 @@ pub fn peak_rss_bytes() -> Option<u64> {
 /// packing fraction `eta` in a periodic box, Maxwell velocities at kT = 1 (the engine's and
 /// the floor's, [`super::floor`], alike).
 pub fn initial_state(n: usize, eta: f64, seed: u64) -> Result<(Vec<Particle<2>>, SimBox<2>), String> {
+    // Close packing of equal disks: π/(2√3) ≈ 0.9069.
+    if !(eta > 0.0 && eta < 0.9069) {
+        return Err(format!("--eta {eta}: the packing fraction must lie in (0, 0.9069) (close packing is π/(2√3))"));
+    }
+    if n < 2 {
+        return Err(format!("--n {n}: a benchmark needs at least 2 disks"));
+    }
+    let needed = n as f64 * crate::run::limits::BYTES_PER_PARTICLE as f64;
+    if let Some(available) = crate::run::Limits::for_this_machine().memory
+        && needed > available as f64
+    {
+        return Err(format!(
+            "--n {n}: that many disks need about {:.3} GB of memory; this machine has {:.3} GB available",
+            needed / 1e9,
+            available as f64 / 1e9
+        ));
+    }
     let species = vec![Species { count: n, radius: 0.5, mass: 1.0 }];
-    let sim_box = box_for_packing_fraction(&species, eta, [Boundary::Periodic; 2], Placement::Triangular, 1.0);
+    let sim_box = box_for_packing_fraction(&species, eta, [Boundary::Periodic; 2], Placement::Triangular, None);
     let particles = initial_particles(&species, &sim_box, Placement::Triangular, Velocities::Maxwell, 1.0, seed)
         .map_err(|e| e.to_string())?;
     Ok((particles, sim_box))

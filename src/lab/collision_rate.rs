@@ -91,7 +91,7 @@ pub fn measure(eta: f64, n: usize, per_particle: u64, seed: u64) -> Result<RateS
             (last_t, last_c) = (s.t, s.collisions);
         }
     }
-    let summary = run.summary(1.0);
+    let summary = run.summary();
     let (_, gamma_err) = block_error(&rates, 20);
     let (identity_difference, identity_difference_err) = block_error(&diffs, 20);
     let gamma = summary.collision_rate_per_particle;

@@ -124,7 +124,7 @@ pub fn measure(eta: f64, n: usize, equilibration: u64, production: u64, seed: u6
     while !run.done() {
         run.step().ok_or("the gas stopped")?;
     }
-    let s = run.summary(1.0);
+    let s = run.summary();
     Ok(Point {
         eta,
         z: s.compressibility,

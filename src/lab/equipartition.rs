@@ -53,7 +53,7 @@ pub fn relax(
         Species { count: n / 2, radius: radii[0], mass: 1.0 },
         Species { count: n - n / 2, radius: radii[1], mass: 10.0 },
     ];
-    let sim_box = box_for_packing_fraction(&species, 0.3, [Boundary::Periodic; 2], Placement::Triangular, 1.0);
+    let sim_box = box_for_packing_fraction(&species, 0.3, [Boundary::Periodic; 2], Placement::Triangular, None);
     let mut particles = initial_particles(&species, &sim_box, Placement::Triangular, Velocities::Maxwell, 1.0, seed)
         .map_err(|e| e.to_string())?;
     // Heat A to kT = 2 and cool B to kT = 0.5 (the total momentum stays zero only on average;

@@ -112,7 +112,7 @@ pub fn run(options: &Options) -> Result<ExperimentResult, String> {
     let (n, horizon) = if options.quick { (2000, 20.0) } else { (20000, 30.0) };
     let eta: f64 = 0.3;
     let species = vec![Species { count: n, radius: 0.5, mass: 1.0 }];
-    let sim_box = box_for_packing_fraction(&species, eta, [Boundary::Periodic; 2], Placement::Triangular, 1.0);
+    let sim_box = box_for_packing_fraction(&species, eta, [Boundary::Periodic; 2], Placement::Triangular, None);
     let particles =
         initial_particles(&species, &sim_box, Placement::Triangular, Velocities::FixedSpeed, 1.0, options.seed)
             .map_err(|e| e.to_string())?;

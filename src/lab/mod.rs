@@ -68,7 +68,7 @@ impl ExperimentResult {
     /// Writes `result.json` (atomically) into the experiment's directory.
     pub fn write(&self, out: &Path) -> Result<(), OutputError> {
         let dir = ExperimentResult::dir(out, &self.name);
-        std::fs::create_dir_all(&dir).map_err(|error| OutputError { path: dir.clone(), error })?;
+        std::fs::create_dir_all(&dir).map_err(crate::io::rundir::at(&dir))?;
         let text = serde_json::to_string_pretty(self).expect("results serialise");
         write_atomic(&dir.join("result.json"), text.as_bytes())
     }
@@ -77,25 +77,43 @@ impl ExperimentResult {
 /// An experiment's entry point.
 pub type Experiment = fn(&Options) -> Result<ExperimentResult, String>;
 
+/// The options of an experiment on the command line (`--quick`, `--seed`, `--out`): the
+/// experiment binaries and `collide experiment` take the same.
+#[derive(clap::Args, Clone, Debug)]
+pub struct ExperimentArgs {
+    /// CI-sized run (seconds) instead of report quality.
+    #[arg(long)]
+    pub quick: bool,
+    /// Seed of the initial states.
+    #[arg(long, default_value_t = 1)]
+    pub seed: u64,
+    /// Output directory.
+    #[arg(long, default_value = "lab-out")]
+    pub out: PathBuf,
+}
+
+impl From<ExperimentArgs> for Options {
+    fn from(args: ExperimentArgs) -> Options {
+        Options { quick: args.quick, seed: args.seed, out: args.out }
+    }
+}
+
 /// `main` of an experiment binary: parses `--quick`, `--seed`, `--out`, runs, writes, prints
 /// the verdict table, and exits 1 if a check fails (2 on an error).
 pub fn main_for(name: &str, experiment: Experiment) -> ExitCode {
     use clap::Parser;
     #[derive(Parser)]
     struct Args {
-        /// CI-sized run (seconds).
-        #[arg(long)]
-        quick: bool,
-        /// Seed of the initial states.
-        #[arg(long, default_value_t = 1)]
-        seed: u64,
-        /// Output directory.
-        #[arg(long, default_value = "lab-out")]
-        out: PathBuf,
+        #[command(flatten)]
+        options: ExperimentArgs,
     }
-    let args = Args::parse();
-    let options = Options { quick: args.quick, seed: args.seed, out: args.out };
-    match experiment(&options).and_then(|r| r.write(&options.out).map(|_| r).map_err(|e| e.to_string())) {
+    run_one(name, experiment, &Args::parse().options.into())
+}
+
+/// Runs one experiment, writes its results, prints the verdict table, and says how it went:
+/// 0 if every check passes, 1 if one fails, 2 on an error.
+pub fn run_one(name: &str, experiment: Experiment, options: &Options) -> ExitCode {
+    match experiment(options).and_then(|r| r.write(&options.out).map(|_| r).map_err(|e| e.to_string())) {
         Ok(result) => {
             // Writes that fail (stdout closed, e.g. piped into `head`) are not errors of the run.
             use std::io::Write as _;

@@ -108,7 +108,7 @@ pub fn measure(eta: f64, n: usize, collisions_per_particle: u64, seed: u64) -> R
             mid.push(inside as f64 / ((lengths[0] - 2.0 * BULK_MARGIN) * (lengths[1] - 2.0 * BULK_MARGIN)));
         }
     }
-    let s = run.summary(1.0);
+    let s = run.summary();
     let samples = &run.thermo.samples;
     let walls: Vec<f64> = samples
         .iter()

@@ -159,7 +159,7 @@ impl<const D: usize> Observer<D> for Thermo {
                 self.interval = Totals { wall_impulse: vec![[0.0; 2]; D], ..Totals::default() };
                 self.interval_start = now;
             }
-            Outcome::Rebuild => {}
+            Outcome::Rebuild { .. } => {}
         }
     }
 }

@@ -1,6 +1,6 @@
 //! C99 hexadecimal floating-point literals (`0x1.8p+1` = 3): exact text for f64.
 //!
-//! [`format`] writes the shortest exact form (`printf("%a")` style, normalised, subnormals as
+//! [`format`](fn@format) writes the shortest exact form (`printf("%a")` style, normalised, subnormals as
 //! `0x0.…p-1022`); [`parse`] reads any C99 hex literal, correctly rounded to nearest-even.
 
 use core::fmt;

@@ -49,8 +49,8 @@ struct Group([Slot; ARITY]);
 /// One pending event per particle, earliest first.
 ///
 /// Every level of the walk from a slot to the root reads the four children of one node, and
-/// they fill one cache line: the internal nodes are stored four siblings to a [`Quad`] (the
-/// root apart), the slots four siblings to a [`Group`] (packed to 16 bytes, and shifted so
+/// they fill one cache line: the internal nodes are stored four siblings to a `Quad` (the
+/// root apart), the slots four siblings to a `Group` (packed to 16 bytes, and shifted so
 /// that siblings share a group). With 24-byte events and 16-byte nodes in plain arrays the
 /// four children straddled two lines at every level.
 #[derive(Clone, Debug)]
@@ -206,7 +206,7 @@ impl Tree {
 
     /// A guess at the next event once `a` and `b` have collided, for the lookahead: the
     /// owner of the earliest event outside the two subtrees that hold `a` and `b`
-    /// [`guess_levels`] levels up (4^s slots each, at most a 64th of the particles).
+    /// `guess_levels` levels up (4^s slots each, at most a 64th of the particles).
     ///
     /// Why not [`runner_up`](Self::runner_up): its walk starts at the slots, and the lowest
     /// levels of both paths are the ones out of cache (the upper levels are shared by every

@@ -1,0 +1,303 @@
+//! Initial states in 2D: where the disks start and how fast.
+//!
+//! Placement ([`Placement`]): a triangular or square lattice whose shape follows the box
+//! (`lattice`; dense states, up to η ≈ 0.9 for the triangular lattice), or random
+//! sequential placement with rejection, largest disks first, in expected O(N) (`random`;
+//! dilute states and size-asymmetric mixtures). When a placement cannot work, the error
+//! says how far it got and what would.
+//!
+//! Velocities: Maxwell–Boltzmann (each component normal with variance kT/m), or one speed
+//! per species in uniformly random directions (`|v| = √(2kT/m)` in 2D, for relaxation
+//! experiments). Then the total momentum is removed along periodic axes, and all
+//! velocities are scaled so that `2K / dof` equals the target kT exactly (to rounding).
+//! Everything random comes from one seeded `Xoshiro256PlusPlus` (portable and
+//! reproducible; rand documents `StdRng` and `SmallRng` as not portable).
+
+mod lattice;
+mod random;
+
+use super::geometry::{Boundary, Particle, SimBox};
+use nalgebra::{SVector, Vector2};
+use rand::rngs::Xoshiro256PlusPlus;
+use rand::seq::SliceRandom;
+use rand::{RngExt, SeedableRng};
+use rand_distr::{Distribution, Normal};
+use serde::{Deserialize, Serialize};
+use std::f64::consts::{PI, TAU};
+use std::fmt;
+
+/// One kind of disk.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Species {
+    /// How many.
+    pub count: usize,
+    /// Radius (σ/2 for a disk of diameter σ).
+    pub radius: f64,
+    /// Mass.
+    pub mass: f64,
+}
+
+/// Where the disks start.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum Placement {
+    /// Random sequential placement with rejection (dilute states).
+    Random,
+    /// Triangular lattice (vacancies chosen at random when N does not fill it).
+    Triangular,
+    /// Square lattice.
+    Square,
+}
+
+/// How the disks start moving.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum Velocities {
+    /// Maxwell–Boltzmann at kT.
+    Maxwell,
+    /// One speed per species, √(2kT/m), random directions.
+    FixedSpeed,
+}
+
+/// Why an initial state could not be built.
+#[non_exhaustive]
+#[derive(Clone, Debug, PartialEq)]
+pub enum InitError {
+    /// Random placement gave up: no room was found for a disk in 10⁴ tries.
+    CannotPlace {
+        /// Disks placed before giving up.
+        placed: usize,
+        /// Disks requested.
+        requested: usize,
+        /// The species of the disk that found no room.
+        species: usize,
+        /// Its radius.
+        radius: f64,
+        /// The packing fraction of the disks placed.
+        reached: f64,
+        /// The packing fraction asked for.
+        requested_eta: f64,
+        /// The packing fraction up to which a triangular lattice holds these species with
+        /// its sites a largest diameter apart ([`lattice_limit`]).
+        lattice_fits_up_to: f64,
+    },
+    /// Even the best lattice shape puts its sites closer than the smallest diameter.
+    LatticeDoesNotFit {
+        /// "triangular" or "square".
+        lattice: &'static str,
+        /// Columns of the best shape.
+        columns: usize,
+        /// Rows of the best shape.
+        rows: usize,
+        /// The distance between its nearest sites.
+        spacing: f64,
+        /// The largest diameter.
+        diameter: f64,
+        /// The packing fraction at which the same lattice in a box of the same shape
+        /// would fit, if it can be said.
+        fits_up_to: Option<f64>,
+    },
+    /// A box edge shorter than the largest diameter.
+    BoxTooSmall {
+        /// The axis.
+        axis: usize,
+        /// Its length.
+        length: f64,
+        /// The largest diameter.
+        diameter: f64,
+    },
+    /// No temperature can be set: a box with all axes periodic needs two particles (the
+    /// momentum is removed), and there must be a finite, non-zero kinetic energy to scale.
+    TooFewForTemperature,
+}
+
+impl fmt::Display for InitError {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self {
+            InitError::CannotPlace {
+                placed,
+                requested,
+                species,
+                radius,
+                reached,
+                requested_eta,
+                lattice_fits_up_to,
+            } => {
+                write!(
+                    f,
+                    "random placement found no room for disk {} of {requested} (species {species}, radius {radius}) in {} tries, at packing fraction {reached:.4} of the {requested_eta:.4} asked for (random sequential placement jams near η ≈ {JAMMING} for equal disks, and gives up before): ",
+                    placed + 1,
+                    random::TRIES
+                )?;
+                if lattice_fits_up_to >= requested_eta {
+                    write!(
+                        f,
+                        "use placement = \"triangular\", which holds these disks up to η ≈ {lattice_fits_up_to:.4}"
+                    )
+                } else {
+                    write!(
+                        f,
+                        "no placement reaches it: a triangular lattice holds these disks up to η ≈ {lattice_fits_up_to:.4}, random placement got to {reached:.4}; start at or below {:.4}",
+                        lattice_fits_up_to.max(*reached)
+                    )
+                }
+            }
+            InitError::LatticeDoesNotFit { lattice, columns, rows, spacing, diameter, fits_up_to } => {
+                write!(
+                    f,
+                    "a {lattice} lattice does not fit: its best shape in this box, {columns} × {rows} sites, puts them {spacing:.6} apart, less than the diameter {diameter}"
+                )?;
+                match fits_up_to {
+                    Some(eta) => write!(
+                        f,
+                        "; in a box of this shape it fits up to packing fraction ≈ {eta:.4}, or give a box nearer the lattice's own shape"
+                    ),
+                    None => write!(f, "; make the box larger"),
+                }
+            }
+            InitError::BoxTooSmall { axis, length, diameter } => {
+                write!(f, "box edge {axis} = {length} is shorter than the largest diameter {diameter}")
+            }
+            InitError::TooFewForTemperature => write!(
+                f,
+                "no temperature can be set: a fully periodic box needs at least 2 moving particles (the total momentum is removed, which leaves one alone at rest), and the kinetic energy must be a finite number"
+            ),
+        }
+    }
+}
+
+impl std::error::Error for InitError {}
+
+/// The random sequential adsorption (jamming) limit of equal disks, θ∞ ≈ 0.547
+/// (Hinrichsen, Feder & Jøssang, J. Stat. Phys. 44, 793 (1986)).
+const JAMMING: f64 = 0.547;
+
+/// The packing fraction up to which a perfect triangular lattice of N sites holds these
+/// species with nearest sites one largest diameter apart: `Σπ Rᵢ² / (N·(√3/2)·σ_max²)`.
+pub fn lattice_limit(species: &[Species]) -> f64 {
+    let n: f64 = species.iter().map(|s| s.count as f64).sum();
+    let sigma = 2.0 * species.iter().map(|s| s.radius).fold(0.0, f64::max);
+    disk_area(species) / (n * 0.5 * 3f64.sqrt() * sigma * sigma)
+}
+
+/// Total disk area Σ πRᵢ².
+pub fn disk_area(species: &[Species]) -> f64 {
+    species.iter().map(|s| s.count as f64 * PI * s.radius * s.radius).sum()
+}
+
+/// The box with packing fraction `eta` for these species, `aspect = Ly/Lx`. Without an
+/// aspect, a triangular lattice in a periodic box takes its own (so that it is perfect and
+/// wraps without defects), and every other start a square box.
+pub fn box_for_packing_fraction(
+    species: &[Species],
+    eta: f64,
+    boundary: [Boundary; 2],
+    placement: Placement,
+    aspect: Option<f64>,
+) -> SimBox<2> {
+    let n: usize = species.iter().map(|s| s.count).sum();
+    let area = disk_area(species) / eta;
+    let aspect = match aspect {
+        Some(aspect) => aspect,
+        None if placement == Placement::Triangular && boundary == [Boundary::Periodic; 2] => {
+            let (nx, ny) = lattice::triangular_shape(n, true);
+            ny as f64 * 3f64.sqrt() / 2.0 / nx as f64
+        }
+        None => 1.0,
+    };
+    let lx = (area / aspect).sqrt();
+    SimBox { lengths: Vector2::new(lx, lx * aspect), boundary }
+}
+
+/// Builds the initial particles.
+pub fn initial_particles(
+    species: &[Species],
+    sim_box: &SimBox<2>,
+    placement: Placement,
+    velocities: Velocities,
+    kt: f64,
+    seed: u64,
+) -> Result<Vec<Particle<2>>, InitError> {
+    let mut rng = Xoshiro256PlusPlus::seed_from_u64(seed);
+    // Species of each particle, in a random order.
+    let mut kinds: Vec<usize> = species.iter().enumerate().flat_map(|(k, s)| std::iter::repeat_n(k, s.count)).collect();
+    kinds.shuffle(&mut rng);
+    let n = kinds.len();
+    let rmax = species.iter().map(|s| s.radius).fold(0.0, f64::max);
+    let rmin = species.iter().map(|s| s.radius).fold(f64::INFINITY, f64::min);
+    for axis in 0..2 {
+        let length = sim_box.lengths[axis];
+        if !(length >= 2.0 * rmax) {
+            return Err(InitError::BoxTooSmall { axis, length, diameter: 2.0 * rmax });
+        }
+    }
+    let positions = match placement {
+        Placement::Random => random::positions(&kinds, species, sim_box, &mut rng)?,
+        Placement::Triangular | Placement::Square => {
+            let kind =
+                if placement == Placement::Triangular { lattice::Kind::Triangular } else { lattice::Kind::Square };
+            let eta = disk_area(species) / sim_box.volume();
+            let mut sites = lattice::sites(kind, n, sim_box, rmax, rmin, eta)?;
+            if sites.len() > n {
+                sites.shuffle(&mut rng);
+                sites.truncate(n);
+                // Keep a spatial order (row-major) for cache locality; vacancies stay random.
+                sites.sort_by(|a, b| a[1].total_cmp(&b[1]).then(a[0].total_cmp(&b[0])));
+            }
+            sites
+        }
+    };
+    let mut particles: Vec<Particle<2>> = positions
+        .into_iter()
+        .zip(&kinds)
+        .map(|(position, &k)| Particle {
+            position,
+            velocity: SVector::zeros(),
+            time: 0.0,
+            radius: species[k].radius,
+            mass: species[k].mass,
+            species: k as u32,
+            events: 0,
+        })
+        .collect();
+    for p in &mut particles {
+        p.velocity = match velocities {
+            Velocities::Maxwell => {
+                let normal = Normal::new(0.0, (kt / p.mass).sqrt()).map_err(|_| InitError::TooFewForTemperature)?;
+                Vector2::new(normal.sample(&mut rng), normal.sample(&mut rng))
+            }
+            Velocities::FixedSpeed => {
+                let theta: f64 = rng.random_range(0.0..TAU);
+                Vector2::new(theta.cos(), theta.sin()) * (2.0 * kt / p.mass).sqrt()
+            }
+        };
+    }
+    set_temperature(&mut particles, sim_box, kt)?;
+    Ok(particles)
+}
+
+/// Removes the total momentum along periodic axes, then scales every velocity so that
+/// `2K/dof = kt` (dof = 2N less one per periodic axis).
+pub fn set_temperature(particles: &mut [Particle<2>], sim_box: &SimBox<2>, kt: f64) -> Result<(), InitError> {
+    let total_mass: f64 = particles.iter().map(|p| p.mass).sum();
+    let momentum: SVector<f64, 2> = particles.iter().map(|p| p.velocity * p.mass).sum();
+    for a in 0..2 {
+        if sim_box.boundary[a] == Boundary::Periodic {
+            let drift = momentum[a] / total_mass;
+            for p in particles.iter_mut() {
+                p.velocity[a] -= drift;
+            }
+        }
+    }
+    let dof = (2 * particles.len()).saturating_sub(sim_box.periodic_axes()) as f64;
+    let kinetic: f64 = particles.iter().map(Particle::kinetic_energy).sum();
+    if dof <= 0.0 || !(kinetic > 0.0 && kinetic.is_finite()) {
+        return Err(InitError::TooFewForTemperature);
+    }
+    let scale = (kt * dof / (2.0 * kinetic)).sqrt();
+    for p in particles.iter_mut() {
+        p.velocity *= scale;
+    }
+    Ok(())
+}

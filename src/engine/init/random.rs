@@ -1,0 +1,276 @@
+//! Random sequential placement: each disk at a uniformly random accessible position,
+//! rejected if it overlaps one already placed (minimum image), up to [`TRIES`] tries per
+//! disk; the largest disks first, so that a few large disks among many small ones find room
+//! before the small ones fill the box.
+//!
+//! Placed disks are kept in cell grids, one per *size class* (radii within a factor of two:
+//! the same binary exponent), each with cells at least one class diameter wide. A candidate
+//! of radius `r` can only overlap disks of a class of largest radius `r_c` within `r + r_c`,
+//! so it looks at `⌈(r + r_c)/w⌉ + 1` cells each way in that class's grid, `w` the cell
+//! width: O(1) work per try at any density, and expected O(N) for the whole placement
+//! (the plain search over every placed disk made it O(N²): 0.5 s, 2 s, 8 s for 10⁴, 2·10⁴,
+//! 4·10⁴ disks). The test for overlap is the one of the plain search, evaluated for the same
+//! pairs that could fail it, and the random numbers are drawn in the same order, so the
+//! placement is exactly what a search over every placed disk would give.
+
+use super::{InitError, Species};
+use crate::engine::geometry::{Boundary, SimBox};
+use nalgebra::SVector;
+use rand::RngExt;
+use rand::rngs::Xoshiro256PlusPlus;
+
+/// Tries per disk before giving up.
+pub(super) const TRIES: usize = 10_000;
+
+/// A cell grid of the disks of one size class, as lists threaded through the placed disks.
+struct Grid {
+    /// The binary exponent of the class's radii.
+    class: u64,
+    /// The largest radius in the class.
+    radius: f64,
+    /// Cells per axis.
+    counts: [usize; 2],
+    /// Cell widths.
+    widths: [f64; 2],
+    /// First member of each cell (`NONE`: empty).
+    heads: Vec<u32>,
+}
+
+const NONE: u32 = u32::MAX;
+
+fn class_of(radius: f64) -> u64 {
+    radius.to_bits() >> 52
+}
+
+impl Grid {
+    /// A grid for `count` disks of largest radius `radius`, with cells at least a diameter
+    /// wide and at most about four per disk (a few tiny disks in a large box need no
+    /// billions of cells).
+    fn new(class: u64, radius: f64, count: usize, sim_box: &SimBox<2>) -> Grid {
+        let cap = (4 * count + 16) as f64;
+        let mut counts = [0usize; 2];
+        let mut fit = [0f64; 2];
+        for a in 0..2 {
+            fit[a] = (sim_box.lengths[a] / (2.0 * radius)).floor().clamp(1.0, 1e9);
+        }
+        let excess = fit[0] * fit[1] / cap;
+        let shrink = if excess > 1.0 { excess.sqrt() } else { 1.0 };
+        for a in 0..2 {
+            counts[a] = ((fit[a] / shrink).floor() as usize).max(1);
+        }
+        let widths = [sim_box.lengths[0] / counts[0] as f64, sim_box.lengths[1] / counts[1] as f64];
+        Grid { class, radius, counts, widths, heads: vec![NONE; counts[0] * counts[1]] }
+    }
+
+    fn cell(&self, x: &SVector<f64, 2>, axis: usize) -> usize {
+        let m = (x[axis] / self.widths[axis]).floor();
+        (m.max(0.0) as usize).min(self.counts[axis] - 1)
+    }
+
+    /// The cell indices along `axis` within `reach` cells of `m`: each once, wrapped along a
+    /// periodic axis, cut at the walls.
+    fn span(&self, m: usize, reach: usize, axis: usize, boundary: Boundary) -> Vec<usize> {
+        let n = self.counts[axis];
+        if 2 * reach + 1 >= n {
+            return (0..n).collect();
+        }
+        match boundary {
+            Boundary::Periodic => (0..=2 * reach).map(|k| (m + n + k - reach) % n).collect(),
+            Boundary::Wall => (m.saturating_sub(reach)..=(m + reach).min(n - 1)).collect(),
+        }
+    }
+}
+
+/// The placement state: every disk placed so far, and the grids that index them.
+struct Placed<'a> {
+    sim_box: &'a SimBox<2>,
+    disks: Vec<(SVector<f64, 2>, f64)>,
+    next: Vec<u32>,
+    grids: Vec<Grid>,
+    /// Pairs tested for overlap so far (the work the grids save is counted by a test).
+    tested: u64,
+}
+
+impl Placed<'_> {
+    /// Whether a disk of radius `r` at `x` overlaps none placed: `|d| ≥ r + s` for the
+    /// minimum image `d` of every placed disk (radius `s`) near enough to fail it.
+    fn clear(&mut self, x: &SVector<f64, 2>, r: f64) -> bool {
+        for grid in &self.grids {
+            let (mx, my) = (grid.cell(x, 0), grid.cell(x, 1));
+            let reach = |a: usize| (((r + grid.radius) / grid.widths[a]).ceil().min(1e9) as usize).saturating_add(1);
+            let xs = grid.span(mx, reach(0), 0, self.sim_box.boundary[0]);
+            let ys = grid.span(my, reach(1), 1, self.sim_box.boundary[1]);
+            for &cy in &ys {
+                for &cx in &xs {
+                    let mut k = grid.heads[cy * grid.counts[0] + cx];
+                    while k != NONE {
+                        self.tested += 1;
+                        let (y, s) = &self.disks[k as usize];
+                        let d = y - x;
+                        let d = d + self.sim_box.minimum_image_shift(&d);
+                        if d.norm() < r + s {
+                            return false;
+                        }
+                        k = self.next[k as usize];
+                    }
+                }
+            }
+        }
+        true
+    }
+
+    fn add(&mut self, x: SVector<f64, 2>, r: f64) {
+        let grid = self.grids.iter_mut().find(|g| g.class == class_of(r)).expect("a grid for every class");
+        let cell = grid.cell(&x, 1) * grid.counts[0] + grid.cell(&x, 0);
+        self.next.push(grid.heads[cell]);
+        grid.heads[cell] = self.disks.len() as u32;
+        self.disks.push((x, r));
+    }
+}
+
+/// Positions for disks of species `kinds[i]`, largest first (ties in the given order).
+pub(super) fn positions(
+    kinds: &[usize],
+    species: &[Species],
+    sim_box: &SimBox<2>,
+    rng: &mut Xoshiro256PlusPlus,
+) -> Result<Vec<SVector<f64, 2>>, InitError> {
+    place(kinds, species, sim_box, rng).map(|(at, _)| at)
+}
+
+/// [`positions`], and how many pairs were tested for overlap.
+fn place(
+    kinds: &[usize],
+    species: &[Species],
+    sim_box: &SimBox<2>,
+    rng: &mut Xoshiro256PlusPlus,
+) -> Result<(Vec<SVector<f64, 2>>, u64), InitError> {
+    let mut order: Vec<usize> = (0..kinds.len()).collect();
+    order.sort_by(|&a, &b| species[kinds[b]].radius.total_cmp(&species[kinds[a]].radius));
+    // The size classes: (binary exponent, largest radius, disks).
+    let mut classes: Vec<(u64, f64, usize)> = Vec::new();
+    for s in species {
+        let class = class_of(s.radius);
+        match classes.iter_mut().find(|c| c.0 == class) {
+            Some(c) => (c.1, c.2) = (c.1.max(s.radius), c.2 + s.count),
+            None => classes.push((class, s.radius, s.count)),
+        }
+    }
+    let grids = classes.into_iter().map(|(class, radius, count)| Grid::new(class, radius, count, sim_box)).collect();
+    let mut placed = Placed { sim_box, disks: Vec::with_capacity(kinds.len()), next: Vec::new(), grids, tested: 0 };
+    let mut at = vec![SVector::<f64, 2>::zeros(); kinds.len()];
+    for &i in &order {
+        let k = kinds[i];
+        let r = species[k].radius;
+        let mut found = None;
+        for _ in 0..TRIES {
+            let mut x = SVector::<f64, 2>::zeros();
+            for a in 0..2 {
+                let (lo, hi) = match sim_box.boundary[a] {
+                    Boundary::Periodic => (0.0, sim_box.lengths[a]),
+                    Boundary::Wall => (r, sim_box.lengths[a] - r),
+                };
+                x[a] = if hi > lo { rng.random_range(lo..hi) } else { lo };
+            }
+            if placed.clear(&x, r) {
+                found = Some(x);
+                break;
+            }
+        }
+        let Some(x) = found else {
+            let area: f64 = placed.disks.iter().map(|(_, s)| std::f64::consts::PI * s * s).sum();
+            return Err(InitError::CannotPlace {
+                placed: placed.disks.len(),
+                requested: kinds.len(),
+                species: k,
+                radius: r,
+                reached: area / sim_box.volume(),
+                requested_eta: super::disk_area(species) / sim_box.volume(),
+                lattice_fits_up_to: super::lattice_limit(species),
+            });
+        };
+        placed.add(x, r);
+        at[i] = x;
+    }
+    Ok((at, placed.tested))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use nalgebra::Vector2;
+    use rand::SeedableRng;
+
+    /// The work per disk does not grow with N: at η = 0.3 the pairs tested per disk placed
+    /// stay within 10 % from 10⁴ to 4·10⁴ disks (a search over every placed disk tests
+    /// N/2 per disk on average: 5 000 to 20 000), and they are a few dozen — for one size
+    /// and for a mixture of radii 30 apart.
+    #[test]
+    fn placement_tests_a_bounded_number_of_pairs_per_disk() {
+        let per_disk = |n: usize, mixture: bool| {
+            let species = if mixture {
+                vec![Species { count: n / 100, radius: 3.0, mass: 1.0 }, Species { count: n, radius: 0.1, mass: 1.0 }]
+            } else {
+                vec![Species { count: n, radius: 0.5, mass: 1.0 }]
+            };
+            let area = super::super::disk_area(&species) / if mixture { 0.1 } else { 0.3 };
+            let l = area.sqrt();
+            let sim_box = SimBox { lengths: Vector2::new(l, l), boundary: [Boundary::Periodic; 2] };
+            let kinds: Vec<usize> =
+                species.iter().enumerate().flat_map(|(k, s)| std::iter::repeat_n(k, s.count)).collect();
+            let mut rng = Xoshiro256PlusPlus::seed_from_u64(5);
+            let (_, tested) = place(&kinds, &species, &sim_box, &mut rng).expect("dilute");
+            tested as f64 / kinds.len() as f64
+        };
+        for mixture in [false, true] {
+            let (small, large) = (per_disk(10_000, mixture), per_disk(40_000, mixture));
+            assert!(large < 1.1 * small && large < 100.0, "mixture {mixture}: {small} then {large} pairs per disk");
+        }
+    }
+
+    /// The grid search gives the positions of the search over every placed disk, bit for
+    /// bit, in periodic and walled boxes, for one species and for a mixture.
+    #[test]
+    fn the_grid_places_as_the_plain_search_does() {
+        for boundary in [[Boundary::Periodic; 2], [Boundary::Wall, Boundary::Periodic]] {
+            for species in [
+                vec![Species { count: 300, radius: 0.5, mass: 1.0 }],
+                vec![Species { count: 5, radius: 2.0, mass: 1.0 }, Species { count: 300, radius: 0.2, mass: 1.0 }],
+            ] {
+                let sim_box = SimBox { lengths: Vector2::new(30.0, 24.0), boundary };
+                let kinds: Vec<usize> =
+                    species.iter().enumerate().flat_map(|(k, s)| std::iter::repeat_n(k, s.count)).collect();
+                let mut rng = Xoshiro256PlusPlus::seed_from_u64(11);
+                let fast = positions(&kinds, &species, &sim_box, &mut rng).expect("dilute");
+                // The plain search, in the same order.
+                let mut rng = Xoshiro256PlusPlus::seed_from_u64(11);
+                let mut order: Vec<usize> = (0..kinds.len()).collect();
+                order.sort_by(|&a, &b| species[kinds[b]].radius.total_cmp(&species[kinds[a]].radius));
+                let mut done: Vec<(SVector<f64, 2>, f64)> = Vec::new();
+                let mut slow = vec![SVector::zeros(); kinds.len()];
+                for &i in &order {
+                    let r = species[kinds[i]].radius;
+                    loop {
+                        let mut x = SVector::<f64, 2>::zeros();
+                        for a in 0..2 {
+                            let (lo, hi) = match boundary[a] {
+                                Boundary::Periodic => (0.0, sim_box.lengths[a]),
+                                Boundary::Wall => (r, sim_box.lengths[a] - r),
+                            };
+                            x[a] = rng.random_range(lo..hi);
+                        }
+                        if done.iter().all(|(y, s)| {
+                            let d = y - x;
+                            (d + sim_box.minimum_image_shift(&d)).norm() >= r + s
+                        }) {
+                            done.push((x, r));
+                            slow[i] = x;
+                            break;
+                        }
+                    }
+                }
+                assert_eq!(fast, slow, "{boundary:?}, {} species", species.len());
+            }
+        }
+    }
+}

@@ -1,0 +1,247 @@
+//! What a run may cost, checked before it allocates or loops: particles, memory, collisions
+//! and samples — the last two estimated from the configuration with Enskog's collision
+//! rate — and the tunables of the watchdog that stops a run whose clock no longer moves.
+//!
+//! # The estimate
+//!
+//! With `n = N/A`, the packing fraction `η`, the mean diameter `σ̄`, the mean mass `m̄` and
+//! Henderson's contact value `g = (1 − 7η/16)/(1 − η)²` (Mol. Phys. 30, 971 (1975)),
+//! Enskog's rate of collisions per particle is `Γ = 2nσ̄·g·√(πkT/m̄)` (2D), and a run of `C`
+//! pair collisions lasts about `T = 2C/(NΓ)`. It is a scheduling estimate — within a few
+//! per cent for a fluid, an overestimate of `T` near close packing where `g` grows faster —
+//! used only to refuse runs that are out of reach by orders of magnitude (10¹⁵⁰ collisions
+//! at `kT = 10³⁰⁰`, 10¹¹ samples at `sample_interval = 10⁻⁹`).
+
+use crate::engine::simulation::MAX_PARTICLES;
+use crate::io::config::Config;
+use crate::io::text::num;
+use std::f64::consts::PI;
+use std::fmt;
+
+/// Tunables of the limits and the watchdog, with automatic defaults
+/// ([`Limits::for_this_machine`]).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Limits {
+    /// The most particles.
+    pub max_particles: usize,
+    /// The most samples a run keeps (each a row of timeseries.csv, held in memory and in
+    /// every checkpoint).
+    pub max_samples: usize,
+    /// The most pair collisions a run or its equilibration may ask for, or be estimated to
+    /// need (10¹⁴: about two years at 10⁶ collisions per second).
+    pub max_collisions: f64,
+    /// The memory a run may take, bytes (`None`: unchecked).
+    pub memory: Option<u64>,
+    /// Events between two looks of the watchdog.
+    pub watchdog_events: u64,
+    /// The watchdog stops a run that, at its pace over the last look, would need more
+    /// events than this to finish.
+    pub max_projected_events: f64,
+}
+
+impl Default for Limits {
+    fn default() -> Self {
+        Limits {
+            max_particles: MAX_PARTICLES,
+            max_samples: 10_000_000,
+            max_collisions: 1e14,
+            memory: None,
+            watchdog_events: 1 << 20,
+            max_projected_events: 1e15,
+        }
+    }
+}
+
+impl Limits {
+    /// The defaults, with the memory limit set to what this machine has available
+    /// (`MemAvailable` in `/proc/meminfo`; unchecked where that cannot be read).
+    pub fn for_this_machine() -> Limits {
+        Limits { memory: available_memory(), ..Limits::default() }
+    }
+}
+
+/// `MemAvailable` from `/proc/meminfo`, in bytes.
+fn available_memory() -> Option<u64> {
+    let text = std::fs::read_to_string("/proc/meminfo").ok()?;
+    let line = text.lines().find(|l| l.starts_with("MemAvailable:"))?;
+    let kib: u64 = line.split_whitespace().nth(1)?.parse().ok()?;
+    kib.checked_mul(1024)
+}
+
+/// Bytes of memory per particle at the peak of a run (the particle records and their copy
+/// while the initial state is built, lattice sites or the placement grids, the queue, the
+/// cell grid and the lists, and the state copied into a checkpoint as it is written),
+/// rounded up from the peak resident memory of `collide run` at N = 10⁶: 280–300 bytes per
+/// disk (triangular at η = 0.5 and 0.7, random at 0.3; `/usr/bin/time -v`).
+pub const BYTES_PER_PARTICLE: u64 = 400;
+
+/// Bytes per sample: one in memory (about 100) and its text in each checkpoint written.
+pub const BYTES_PER_SAMPLE: u64 = 250;
+
+/// What a configuration is expected to cost.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Estimate {
+    /// Enskog's collision rate per particle.
+    pub rate_per_particle: f64,
+    /// The expected simulated time of the production run.
+    pub production_time: f64,
+    /// The expected pair collisions of the production run.
+    pub production_collisions: f64,
+    /// The expected samples.
+    pub samples: f64,
+    /// The expected memory, bytes.
+    pub memory: f64,
+}
+
+/// A run that is out of reach.
+#[non_exhaustive]
+#[derive(Clone, Debug, PartialEq)]
+pub enum LimitError {
+    /// More particles than the engine indexes.
+    TooManyParticles {
+        /// Asked for.
+        n: usize,
+        /// The most.
+        max: usize,
+    },
+    /// More memory than is available.
+    Memory {
+        /// Particles.
+        n: usize,
+        /// Expected samples.
+        samples: f64,
+        /// Bytes needed.
+        needed: f64,
+        /// Bytes available.
+        available: u64,
+    },
+    /// A run length that asks for, or would take, too many collisions.
+    Collisions {
+        /// The configuration key.
+        field: &'static str,
+        /// Its value.
+        value: f64,
+        /// The collisions it asks for or implies.
+        collisions: f64,
+        /// The most.
+        max: f64,
+    },
+    /// More samples than are kept.
+    Samples {
+        /// The expected number.
+        samples: f64,
+        /// The expected production time.
+        time: f64,
+        /// The sampling interval.
+        interval: f64,
+        /// The most.
+        max: usize,
+    },
+}
+
+impl fmt::Display for LimitError {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self {
+            LimitError::TooManyParticles { n, max } => {
+                write!(f, "species: {n} particles in all; the engine takes at most {max}")
+            }
+            LimitError::Memory { n, samples, needed, available } => {
+                write!(f, "species: {n} particles")?;
+                if *samples >= 1.0 {
+                    write!(f, " and about {samples:.3e} samples")?;
+                }
+                write!(
+                    f,
+                    " need about {:.3} GB of memory ({BYTES_PER_PARTICLE} bytes per particle, {BYTES_PER_SAMPLE} per sample); this machine has {:.3} GB available",
+                    needed / 1e9,
+                    *available as f64 / 1e9
+                )
+            }
+            LimitError::Collisions { field, value, collisions, max } => write!(
+                f,
+                "{field} = {}: that is about {collisions:.3e} pair collisions (Enskog's rate), more than the {max:.0e} a run may take; ask for less",
+                num(*value)
+            ),
+            LimitError::Samples { samples, time, interval, max } => write!(
+                f,
+                "run.sample_interval = {}: the run is expected to last about {time:.4e} time units (Enskog's collision rate), which is about {samples:.3e} samples, more than the {max} a run keeps; use a larger interval",
+                num(*interval)
+            ),
+        }
+    }
+}
+
+impl std::error::Error for LimitError {}
+
+/// Henderson's contact value of hard disks at packing fraction `eta` (capped below close
+/// packing, where it is only a rough guide).
+fn contact_value(eta: f64) -> f64 {
+    let eta = eta.min(0.9);
+    (1.0 - 7.0 * eta / 16.0) / ((1.0 - eta) * (1.0 - eta))
+}
+
+/// Checks `config` (already valid) in a box of area `area` against `limits`.
+pub fn check(config: &Config, area: f64, limits: &Limits) -> Result<Estimate, LimitError> {
+    let n = config.n_particles();
+    if n > limits.max_particles {
+        return Err(LimitError::TooManyParticles { n, max: limits.max_particles });
+    }
+    let nf = n as f64;
+    let sigma = config.species.iter().map(|s| s.count as f64 * 2.0 * s.radius).sum::<f64>() / nf;
+    let mass = config.species.iter().map(|s| s.count as f64 * s.mass).sum::<f64>() / nf;
+    let eta = crate::engine::init::disk_area(&config.species) / area;
+    let rate = 2.0 * (nf / area) * sigma * contact_value(eta) * (PI * config.init.kt / mass).sqrt();
+    let collisions_in = |t: f64| 0.5 * nf * rate * t;
+    let time_for = |c: f64| 2.0 * c / (nf * rate);
+    let too_many = |field, value: f64, collisions: f64| {
+        (collisions > limits.max_collisions).then_some(LimitError::Collisions {
+            field,
+            value,
+            collisions,
+            max: limits.max_collisions,
+        })
+    };
+    let (run, eq) = (&config.run, &config.equilibration);
+    for (field, c) in [("run.collisions", run.collisions), ("equilibration.collisions", eq.collisions)] {
+        if let Some(c) = c
+            && let Some(e) = too_many(field, c as f64, c as f64)
+        {
+            return Err(e);
+        }
+    }
+    if let Some(t) = eq.time
+        && let Some(e) = too_many("equilibration.time", t, collisions_in(t))
+    {
+        return Err(e);
+    }
+    // Production stops at whichever length comes first.
+    let production_time = match (run.collisions, run.time) {
+        (Some(c), Some(t)) => time_for(c as f64).min(t),
+        (Some(c), None) => time_for(c as f64),
+        (None, Some(t)) => t,
+        (None, None) => 0.0,
+    };
+    let production_collisions = collisions_in(production_time);
+    if run.collisions.is_none()
+        && let Some(t) = run.time
+        && let Some(e) = too_many("run.time", t, production_collisions)
+    {
+        return Err(e);
+    }
+    let samples = production_time / run.sample_interval;
+    if !(samples <= limits.max_samples as f64) {
+        return Err(LimitError::Samples {
+            samples,
+            time: production_time,
+            interval: run.sample_interval,
+            max: limits.max_samples,
+        });
+    }
+    let memory = nf * BYTES_PER_PARTICLE as f64 + samples * BYTES_PER_SAMPLE as f64;
+    if let Some(available) = limits.memory
+        && memory > available as f64
+    {
+        return Err(LimitError::Memory { n, samples, needed: memory, available });
+    }
+    Ok(Estimate { rate_per_particle: rate, production_time, production_collisions, samples, memory })
+}
