@@ -276,8 +276,30 @@ fn help(command: Option<&str>) -> Result<ExitCode> {
 /// Whether to draw a progress bar on stderr: on a terminal, unless asked not to or under CI
 /// (`CI` set to anything but empty, `0` or `false`).
 fn progress_wanted(quiet: bool) -> bool {
-    let ci = std::env::var("CI").is_ok_and(|v| !matches!(v.trim(), "" | "0" | "false"));
-    !quiet && !ci && io::stderr().is_terminal()
+    draw_progress(quiet, std::env::var("CI").ok().as_deref(), io::stderr().is_terminal())
+}
+
+/// [`progress_wanted`] given `--quiet`, the value of `CI` and whether stderr is a terminal.
+fn draw_progress(quiet: bool, ci: Option<&str>, terminal: bool) -> bool {
+    let ci = ci.is_some_and(|v| !matches!(v.trim(), "" | "0" | "false"));
+    !quiet && !ci && terminal
+}
+
+#[cfg(test)]
+mod tests {
+    use super::draw_progress;
+
+    /// The bar is for a person at a terminal: never in a pipe, under CI (`CI=true` on a
+    /// terminal once drew it), or with --quiet.
+    #[test]
+    fn the_progress_bar_is_drawn_only_for_a_person_at_a_terminal() {
+        assert!(draw_progress(false, None, true));
+        assert!(draw_progress(false, Some("false"), true) && draw_progress(false, Some(""), true));
+        assert!(!draw_progress(false, Some("true"), true));
+        assert!(!draw_progress(false, Some("1"), true));
+        assert!(!draw_progress(true, None, true));
+        assert!(!draw_progress(false, None, false));
+    }
 }
 
 fn check() -> Result<ExitCode> {
