@@ -50,5 +50,6 @@ pub mod io;
 pub mod lab;
 pub mod observe;
 pub mod run;
+pub mod theory;
 
 pub use quadratic;

@@ -99,11 +99,6 @@ impl<'de> Deserialize<'de> for Boundaries {
                 let mut axes = Vec::new();
                 while let Some(name) = seq.next_element::<String>()? {
                     axes.push(named(&name)?);
-                    if axes.len() > 3 {
-                        return Err(de::Error::custom(format!(
-                            "box.boundary has more than 3 entries; expected {ALLOWED}"
-                        )));
-                    }
                 }
                 Ok(Boundaries::PerAxis(axes))
             }

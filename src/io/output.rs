@@ -194,8 +194,8 @@ pub fn run_into(
         Start::Resume { checkpoint, path } => {
             let bytes = checkpoint.run.trajectory_bytes;
             let run = Run::resume(checkpoint).map_err(RunFailure::Run)?;
-            let source = path.parent().map(|p| if p.as_os_str().is_empty() { Path::new(".") } else { p });
-            (run, Some(source.unwrap_or(Path::new(".")).to_path_buf()), bytes)
+            let source = path.parent().filter(|p| !p.as_os_str().is_empty()).unwrap_or(Path::new("."));
+            (run, Some(source.to_path_buf()), bytes)
         }
     };
     let out = RunDir::open(dir, force, continuing.as_deref()).map_err(RunFailure::Output)?;

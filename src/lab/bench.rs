@@ -84,16 +84,7 @@ pub fn initial_state(n: usize, eta: f64, seed: u64) -> Result<(Vec<Particle<2>>,
     if n < 2 {
         return Err(format!("--n {n}: a benchmark needs at least 2 disks"));
     }
-    let needed = n as f64 * crate::run::limits::BYTES_PER_PARTICLE as f64;
-    if let Some(available) = crate::run::Limits::for_this_machine().memory
-        && needed > available as f64
-    {
-        return Err(format!(
-            "--n {n}: that many disks need about {:.3} GB of memory; this machine has {:.3} GB available",
-            needed / 1e9,
-            available as f64 / 1e9
-        ));
-    }
+    crate::run::Limits::for_this_machine().check_memory("--n", n, 0.0).map_err(|e| e.to_string())?;
     let species = vec![Species { count: n, radius: 0.5, mass: 1.0 }];
     let sim_box = box_for_packing_fraction(&species, eta, [Boundary::Periodic; 2], Placement::Triangular, None);
     let particles = initial_particles(&species, &sim_box, Placement::Triangular, Velocities::Maxwell, 1.0, seed)

@@ -51,15 +51,12 @@ pub struct RateState {
     pub mean_free_path: f64,
 }
 
-/// Enskog's Γ at packing fraction η, density n, contact value g (σ = m = kT = 1).
-pub fn gamma_enskog(eta: f64, g: f64) -> f64 {
-    let n = 4.0 * eta / PI;
-    2.0 * n * g * PI.sqrt()
-}
+pub use crate::theory::g_henderson;
 
-/// Henderson's contact value g(σ) = (1 − 7η/16)/(1 − η)², i.e. (Z_H − 1)/(2η).
-pub fn g_henderson(eta: f64) -> f64 {
-    (1.0 - 7.0 * eta / 16.0) / (1.0 - eta).powi(2)
+/// Enskog's Γ ([`crate::theory::enskog_rate_2d`]) at packing fraction η and contact value g,
+/// for σ = m = kT = 1 (number density n = 4η/π).
+pub fn gamma_enskog(eta: f64, g: f64) -> f64 {
+    crate::theory::enskog_rate_2d(4.0 * eta / PI, 1.0, g, 1.0, 1.0)
 }
 
 /// Measures one state.

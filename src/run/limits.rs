@@ -15,7 +15,7 @@
 use crate::engine::simulation::MAX_PARTICLES;
 use crate::io::config::Config;
 use crate::io::text::num;
-use std::f64::consts::PI;
+use crate::theory::{enskog_rate_2d, g_henderson};
 use std::fmt;
 
 /// Tunables of the limits and the watchdog, with automatic defaults
@@ -57,6 +57,20 @@ impl Limits {
     /// (`MemAvailable` in `/proc/meminfo`; unchecked where that cannot be read).
     pub fn for_this_machine() -> Limits {
         Limits { memory: available_memory(), ..Limits::default() }
+    }
+}
+
+impl Limits {
+    /// The memory `n` particles and `samples` samples take ([`BYTES_PER_PARTICLE`],
+    /// [`BYTES_PER_SAMPLE`]), if this machine has it; `field` names what asks for them.
+    pub fn check_memory(&self, field: &'static str, n: usize, samples: f64) -> Result<f64, LimitError> {
+        let needed = n as f64 * BYTES_PER_PARTICLE as f64 + samples * BYTES_PER_SAMPLE as f64;
+        match self.memory {
+            Some(available) if needed > available as f64 => {
+                Err(LimitError::Memory { field, n, samples, needed, available })
+            }
+            _ => Ok(needed),
+        }
     }
 }
 
@@ -106,6 +120,8 @@ pub enum LimitError {
     },
     /// More memory than is available.
     Memory {
+        /// What asks for the particles (`species`, or a command-line option).
+        field: &'static str,
         /// Particles.
         n: usize,
         /// Expected samples.
@@ -145,8 +161,8 @@ impl fmt::Display for LimitError {
             LimitError::TooManyParticles { n, max } => {
                 write!(f, "species: {n} particles in all; the engine takes at most {max}")
             }
-            LimitError::Memory { n, samples, needed, available } => {
-                write!(f, "species: {n} particles")?;
+            LimitError::Memory { field, n, samples, needed, available } => {
+                write!(f, "{field}: {n} particles")?;
                 if *samples >= 1.0 {
                     write!(f, " and about {samples:.3e} samples")?;
                 }
@@ -173,13 +189,6 @@ impl fmt::Display for LimitError {
 
 impl std::error::Error for LimitError {}
 
-/// Henderson's contact value of hard disks at packing fraction `eta` (capped below close
-/// packing, where it is only a rough guide).
-fn contact_value(eta: f64) -> f64 {
-    let eta = eta.min(0.9);
-    (1.0 - 7.0 * eta / 16.0) / ((1.0 - eta) * (1.0 - eta))
-}
-
 /// Checks `config` (already valid) in a box of area `area` against `limits`.
 pub fn check(config: &Config, area: f64, limits: &Limits) -> Result<Estimate, LimitError> {
     let n = config.n_particles();
@@ -190,7 +199,8 @@ pub fn check(config: &Config, area: f64, limits: &Limits) -> Result<Estimate, Li
     let sigma = config.species.iter().map(|s| s.count as f64 * 2.0 * s.radius).sum::<f64>() / nf;
     let mass = config.species.iter().map(|s| s.count as f64 * s.mass).sum::<f64>() / nf;
     let eta = crate::engine::init::disk_area(&config.species) / area;
-    let rate = 2.0 * (nf / area) * sigma * contact_value(eta) * (PI * config.init.kt / mass).sqrt();
+    // Henderson's contact value is only a rough guide near close packing: capped there.
+    let rate = enskog_rate_2d(nf / area, sigma, g_henderson(eta.min(0.9)), config.init.kt, mass);
     let collisions_in = |t: f64| 0.5 * nf * rate * t;
     let time_for = |c: f64| 2.0 * c / (nf * rate);
     let too_many = |field, value: f64, collisions: f64| {
@@ -237,11 +247,6 @@ pub fn check(config: &Config, area: f64, limits: &Limits) -> Result<Estimate, Li
             max: limits.max_samples,
         });
     }
-    let memory = nf * BYTES_PER_PARTICLE as f64 + samples * BYTES_PER_SAMPLE as f64;
-    if let Some(available) = limits.memory
-        && memory > available as f64
-    {
-        return Err(LimitError::Memory { n, samples, needed: memory, available });
-    }
+    let memory = limits.check_memory("species", n, samples)?;
     Ok(Estimate { rate_per_particle: rate, production_time, production_collisions, samples, memory })
 }

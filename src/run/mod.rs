@@ -234,10 +234,8 @@ impl Run {
         checkpoint.verify().map_err(RunError::Checkpoint)?;
         let Saved { config, phase, state, thermo, equilibration, start_counts, wall_time_s, trajectory_bytes: _ } =
             checkpoint.run;
-        let (sim_box, estimate) = admit(&config, &limits).map_err(|e| match e {
-            RunError::Setup(e) => RunError::Checkpoint(CheckpointError::Config(e.to_string())),
-            e => RunError::Checkpoint(CheckpointError::Config(e.to_string())),
-        })?;
+        let (sim_box, estimate) =
+            admit(&config, &limits).map_err(|e| RunError::Checkpoint(CheckpointError::Config(e.to_string())))?;
         let bad = |what: String| Err(RunError::Checkpoint(CheckpointError::State(what)));
         let n = config.n_particles();
         if state.particles.len() != n {
@@ -355,14 +353,24 @@ impl Run {
 
     /// Runs the equilibration (`progress` is called now and then with the fraction done),
     /// then starts production: observers reset, sampling scheduled. For experiments that
-    /// drive production themselves with [`step`](Self::step).
-    pub fn equilibrate(&mut self, mut progress: impl FnMut(f64)) {
-        while self.phase == Phase::Equilibration {
-            if self.equilibrated() || self.sim.step().is_none() {
-                self.start_production();
-            } else if self.sim.counts().pair % 4096 == 0 {
-                progress(self.equilibration_done());
+    /// drive production themselves with [`step`](Self::step). The watchdog watches it as it
+    /// watches [`advance`](Self::advance); a stall ends it, and the summary says so.
+    pub fn equilibrate(&mut self, progress: impl FnMut(f64)) {
+        struct Progress<F>(F);
+        impl<F: FnMut(f64)> Sink for Progress<F> {
+            type Error = std::convert::Infallible;
+            fn event(&mut self, _: &Run, _: &Outcome<2>) -> Result<(), Self::Error> {
+                Ok(())
             }
+            fn progress(&mut self, _: Phase, done: f64) {
+                (self.0)(done);
+            }
+        }
+        if self.phase == Phase::Equilibration {
+            let never = AtomicBool::new(false);
+            // Nothing stops it but a stall, which records itself.
+            let Ok(_) = self.drive(Phase::Equilibration, &never, &mut Progress(progress));
+            self.start_production();
         }
     }
 
@@ -427,53 +435,47 @@ impl Run {
     }
 
     fn advance_inner<S: Sink>(&mut self, stop: &AtomicBool, sink: &mut S) -> Result<Status, S::Error> {
-        let limits = self.limits;
-        let mut events = 0u64;
         if self.phase == Phase::Equilibration {
-            let mut dog = Watchdog::new(&limits, self.sim.time(), self.equilibration_done(), self.sim.counts());
-            while !self.equilibrated() {
-                if stop.load(Ordering::Relaxed) {
-                    return Ok(Status::Interrupted);
-                }
-                let Some(outcome) = self.sim.step() else { break };
-                if dog.due()
-                    && let Some(stall) =
-                        dog.look(&limits, self.sim.time(), self.equilibration_done(), self.sim.counts(), &outcome)
-                {
-                    self.ended = (Status::Stalled, Some(stall));
-                    return Ok(Status::Stalled);
-                }
-                sink.event(self, &outcome)?;
-                events += 1;
-                if events % 4096 == 0 {
-                    sink.progress(Phase::Equilibration, self.equilibration_done());
-                }
+            if let Some(status) = self.drive(Phase::Equilibration, stop, sink)? {
+                return Ok(status);
             }
             self.start_production();
         }
         self.wall_since = Some(Instant::now());
-        let mut dog = Watchdog::new(&limits, self.sim.time(), self.progress(), self.sim.counts());
-        while !self.done() {
+        Ok(self.drive(Phase::Production, stop, sink)?.unwrap_or(Status::Complete))
+    }
+
+    /// Runs one phase until it is over, or nothing can happen any more (`None`), or the
+    /// run must stop (`Some`: interrupted, stalled, too many samples). Both phases take the
+    /// same steps: the phase only says when it is over, how far it is, and whether the
+    /// observer sees the events (production).
+    fn drive<S: Sink>(&mut self, phase: Phase, stop: &AtomicBool, sink: &mut S) -> Result<Option<Status>, S::Error> {
+        let production = phase.is_production();
+        let done = |run: &Run| if production { run.progress() } else { run.equilibration_done() };
+        let limits = self.limits;
+        let mut dog = Watchdog::new(&limits, self.sim.time(), done(self), self.sim.counts());
+        let mut events = 0u64;
+        while !(if production { self.done() } else { self.equilibrated() }) {
             if stop.load(Ordering::Relaxed) {
-                return Ok(Status::Interrupted);
+                return Ok(Some(Status::Interrupted));
             }
-            if self.thermo.samples.len() >= limits.max_samples {
-                return Ok(Status::TooManySamples);
+            if production && self.thermo.samples.len() >= limits.max_samples {
+                return Ok(Some(Status::TooManySamples));
             }
-            let Some(outcome) = self.step() else { break };
+            let Some(outcome) = (if production { self.step() } else { self.sim.step() }) else { break };
             if dog.due()
-                && let Some(stall) = dog.look(&limits, self.sim.time(), self.progress(), self.sim.counts(), &outcome)
+                && let Some(stall) = dog.look(&limits, self.sim.time(), done(self), self.sim.counts(), &outcome)
             {
                 self.ended = (Status::Stalled, Some(stall));
-                return Ok(Status::Stalled);
+                return Ok(Some(Status::Stalled));
             }
             sink.event(self, &outcome)?;
             events += 1;
             if events % 4096 == 0 {
-                sink.progress(Phase::Production, self.progress());
+                sink.progress(phase, done(self));
             }
         }
-        Ok(Status::Complete)
+        Ok(None)
     }
 
     /// The results so far (with production's wall-clock time over every process), marked

@@ -108,18 +108,6 @@ impl Watchdog {
         *self = Watchdog { left: events, time, done, counts };
         stall
     }
-
-    /// [`due`](Self::due), then [`look`](Self::look) when it is time.
-    pub fn tick(
-        &mut self,
-        limits: &Limits,
-        time: f64,
-        done: impl FnOnce() -> f64,
-        counts: EventCounts,
-        last: &Outcome<2>,
-    ) -> Option<Stall> {
-        if self.due() { self.look(limits, time, done(), counts, last) } else { None }
-    }
 }
 
 /// An event in words, naming its particles.
@@ -150,7 +138,7 @@ mod tests {
         let wall = Outcome::Wall { i: 3, axis: 0, upper: true, impulse: 0.0 };
         let mut stall = None;
         for _ in 0..4 {
-            stall = dog.tick(&limits(), time, || done, EventCounts::default(), &wall);
+            stall = if dog.due() { dog.look(&limits(), time, done, EventCounts::default(), &wall) } else { None };
         }
         stall
     }

@@ -69,15 +69,17 @@ impl Grid {
 
     /// The cell indices along `axis` within `reach` cells of `m`: each once, wrapped along a
     /// periodic axis, cut at the walls.
-    fn span(&self, m: usize, reach: usize, axis: usize, boundary: Boundary) -> Vec<usize> {
+    fn span(&self, m: usize, reach: usize, axis: usize, boundary: Boundary) -> impl Iterator<Item = usize> + Clone {
         let n = self.counts[axis];
-        if 2 * reach + 1 >= n {
-            return (0..n).collect();
-        }
-        match boundary {
-            Boundary::Periodic => (0..=2 * reach).map(|k| (m + n + k - reach) % n).collect(),
-            Boundary::Wall => (m.saturating_sub(reach)..=(m + reach).min(n - 1)).collect(),
-        }
+        let (start, end) = if 2 * reach + 1 >= n {
+            (0, n)
+        } else {
+            match boundary {
+                Boundary::Periodic => (m + n - reach, m + n + reach + 1),
+                Boundary::Wall => (m.saturating_sub(reach), (m + reach + 1).min(n)),
+            }
+        };
+        (start..end).map(move |c| c % n)
     }
 }
 
@@ -100,8 +102,8 @@ impl Placed<'_> {
             let reach = |a: usize| (((r + grid.radius) / grid.widths[a]).ceil().min(1e9) as usize).saturating_add(1);
             let xs = grid.span(mx, reach(0), 0, self.sim_box.boundary[0]);
             let ys = grid.span(my, reach(1), 1, self.sim_box.boundary[1]);
-            for &cy in &ys {
-                for &cx in &xs {
+            for cy in ys {
+                for cx in xs.clone() {
                     let mut k = grid.heads[cy * grid.counts[0] + cx];
                     while k != NONE {
                         self.tested += 1;
