@@ -3,7 +3,7 @@
 //! events until one more pair collision has happened, so criterion's throughput is in
 //! collisions per second.
 //!
-//! `engine/floor` times the hardware's floor (`collide::lab::floor`: two disks moved,
+//! `engine/floor` times the hardware's floor (`collide::bench::floor`: two disks moved,
 //! bounced and re-predicted against eight fixed neighbours, no queue) at N = 10⁴ and 10⁵,
 //! η = 0.65, per collision, without and with its lookahead: what the engine's rate is a
 //! fraction of.
@@ -15,12 +15,12 @@
 //! a queue of 10⁴ by a later one, with either structure (per update, as after every
 //! collision; in the tree the root owner's is the longest walk).
 
-use collide::engine::events::{
-    LANES, Lanes, PairBracket, Pending, PendingKind, bracket_neighbours, bracket_pair, pair_positions,
-};
 use collide::engine::init::{Placement, Species, Velocities, box_for_packing_fraction, initial_particles};
-use collide::engine::queue::{EventQueue, QueueKind};
+use collide::engine::internals::{
+    EventQueue, LANES, Lanes, PairBracket, QueueKind, bracket_neighbours, bracket_pair, pair_positions,
+};
 use collide::engine::{Boundary, Simulation};
+use collide::engine::{Event, EventKind};
 use criterion::{BenchmarkId, Criterion, Throughput, criterion_group, criterion_main};
 use rand::rngs::Xoshiro256PlusPlus;
 use rand::{RngExt, SeedableRng};
@@ -32,8 +32,8 @@ fn warmed_up(n: usize, eta: f64) -> Simulation<2> {
     let sim_box = box_for_packing_fraction(&species, eta, [Boundary::Periodic; 2], Placement::Triangular, None);
     let particles = initial_particles(&species, &sim_box, Placement::Triangular, Velocities::Maxwell, 1.0, 1).unwrap();
     let mut sim = Simulation::new(particles, sim_box).unwrap();
-    // As `collide bench` does: the lattice relaxes (see `collide::lab::bench::WARMUP`).
-    while sim.counts().pair < collide::lab::bench::WARMUP * n as u64 {
+    // As `collide bench` does: the lattice relaxes (see `collide::bench::WARMUP`).
+    while sim.counts().pair < collide::bench::WARMUP * n as u64 {
         sim.step().unwrap();
     }
     sim
@@ -60,7 +60,7 @@ fn engine(c: &mut Criterion) {
     group.finish();
 }
 
-/// The hardware's floor (`collide::lab::floor`) at η = 0.65: per collision, for the
+/// The hardware's floor (`collide::bench::floor`) at η = 0.65: per collision, for the
 /// engine's rate as a fraction of it.
 fn floor(c: &mut Criterion) {
     let mut group = c.benchmark_group("engine/floor");
@@ -68,7 +68,7 @@ fn floor(c: &mut Criterion) {
     for n in [10_000, 100_000] {
         // Both loops, as `collide bench` times them (it reports the faster).
         for lookahead in [false, true] {
-            let mut floor = collide::lab::floor::Floor::new(n, 0.65, 1).unwrap();
+            let mut floor = collide::bench::floor::Floor::new(n, 0.65, 1).unwrap();
             let mut rng = Xoshiro256PlusPlus::seed_from_u64(2);
             let name = if lookahead { "eta=0.65/lookahead" } else { "eta=0.65/plain" };
             group.bench_function(BenchmarkId::new(name, n), |b| {
@@ -134,10 +134,10 @@ fn parts(c: &mut Criterion) {
         })
     });
     // A queue of 10⁴ events; each update moves the earliest one later by a pseudo-random step.
-    let wall = |time| Pending { time, kind: PendingKind::Wall { axis: 0, upper: true } };
+    let wall = |time| Event { time, kind: EventKind::Wall { axis: 0, upper: true } };
     let mut rng = Xoshiro256PlusPlus::seed_from_u64(3);
     let mut next = move || rng.random_range(0.0..100_000.0f64).floor();
-    let start: Vec<Pending> = (0..10_000).map(|_| wall(next())).collect();
+    let start: Vec<Event> = (0..10_000).map(|_| wall(next())).collect();
     group.throughput(Throughput::Elements(1));
     for (name, kind) in [("queue_set_first/tree", QueueKind::Tree), ("queue_set_first/calendar", QueueKind::Calendar)] {
         let mut queue = EventQueue::new(start.clone(), kind);

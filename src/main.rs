@@ -4,9 +4,9 @@
 use anyhow::{Context, Result, bail};
 use clap::{Args, Parser, Subcommand};
 use collide::engine::Neighbourhood;
-use collide::io::numbers::{NumberFormat, format_text, parse_text};
-use collide::io::query::{DynBall, Query, answer_lines, contact_time_dyn};
 use collide::quadratic::Roots;
+use collide::query::numbers::{NumberFormat, format_text, parse_text};
+use collide::query::{DynBall, Query, answer_lines, contact_time_dyn};
 use std::io::{self, BufWriter, IsTerminal};
 use std::path::PathBuf;
 use std::process::ExitCode;
@@ -93,7 +93,7 @@ enum Command {
 #[derive(Args)]
 struct ExperimentArgs {
     /// Which experiment.
-    #[arg(value_parser = clap::builder::PossibleValuesParser::new(collide::lab::report::EXPERIMENTS.iter().map(|(name, _)| *name)))]
+    #[arg(value_parser = clap::builder::PossibleValuesParser::new(collide::lab::EXPERIMENTS.iter().map(|(name, _)| *name)))]
     name: String,
     #[command(flatten)]
     options: collide::lab::ExperimentArgs,
@@ -224,15 +224,12 @@ fn run(cli: Cli) -> Result<ExitCode> {
         Command::Check => check(),
         Command::Bench(args) => bench(args),
         Command::BenchPoint { n, eta, warmup, timed, seed, neighbourhood } => {
-            let point =
-                collide::lab::bench::measure(n, eta, neighbourhood, warmup, timed, seed).map_err(anyhow::Error::msg)?;
+            let point = collide::bench::measure(n, eta, neighbourhood, warmup, timed, seed)?;
             say!("{}", serde_json::to_string(&point)?);
             Ok(ExitCode::SUCCESS)
         }
         Command::BenchFloor { n, eta, timed, seed } => {
-            for point in
-                collide::lab::floor::measure_both(n, eta, 2 * n as u64, timed, seed).map_err(anyhow::Error::msg)?
-            {
+            for point in collide::bench::floor::measure_both(n, eta, 2 * n as u64, timed, seed)? {
                 say!("{}", serde_json::to_string(&point)?);
             }
             Ok(ExitCode::SUCCESS)
@@ -241,10 +238,8 @@ fn run(cli: Cli) -> Result<ExitCode> {
         Command::Roots(args) => roots(args),
         Command::ContactTime(args) => contact(args),
         Command::Experiment(args) => {
-            let (name, experiment) = collide::lab::report::EXPERIMENTS
-                .iter()
-                .find(|(name, _)| *name == args.name)
-                .expect("clap checked the name");
+            let (name, experiment) =
+                collide::lab::EXPERIMENTS.iter().find(|(name, _)| *name == args.name).expect("clap checked the name");
             Ok(collide::lab::run_one(name, *experiment, &args.options.into()))
         }
         Command::Help { command } => help(command.as_deref()),
@@ -262,11 +257,7 @@ fn help(command: Option<&str>) -> Result<ExitCode> {
             None => {
                 let names: Vec<String> =
                     cli.get_subcommands().filter(|c| !c.is_hide_set()).map(|c| c.get_name().to_string()).collect();
-                bail!(
-                    "help: there is no command '{}' (commands: {})",
-                    collide::io::text::excerpt(name),
-                    names.join(", ")
-                );
+                bail!("help: there is no command '{}' (commands: {})", collide::text::excerpt(name), names.join(", "));
             }
         },
     }
@@ -386,14 +377,14 @@ fn contact(args: ContactArgs) -> Result<ExitCode> {
         velocity: vector(&args.v2, "v2")?,
         radius: scalar(&args.radius2, "R2")?,
     };
-    let t = contact_time_dyn(&first, &second).map_err(anyhow::Error::msg)?;
+    let t = contact_time_dyn(&first, &second)?;
     say!("{}", t.map_or_else(|| "never".to_string(), |t| format_text(t, format)));
     Ok(ExitCode::SUCCESS)
 }
 
 fn run_simulation(args: RunArgs) -> Result<ExitCode> {
-    use collide::io::config::{Config, DEFAULT_CONFIG};
-    use collide::io::output::{RunFailure, RunOptions, Start, load_checkpoint, run_into};
+    use collide::run::config::{Config, DEFAULT_CONFIG};
+    use collide::run::output::{RunFailure, RunOptions, Start, load_checkpoint, run_into};
     use collide::run::{Phase, Status};
     use std::sync::Arc;
     use std::sync::atomic::AtomicBool;
@@ -428,7 +419,7 @@ fn run_simulation(args: RunArgs) -> Result<ExitCode> {
         signal_hook::flag::register(signal, Arc::clone(&stop)).context("installing the signal handlers")?;
     }
     let (start, source) = if let Some(path) = &args.resume {
-        let checkpoint = load_checkpoint(path).map_err(anyhow::Error::msg)?;
+        let checkpoint = load_checkpoint::<2>(path).map_err(|e| anyhow::anyhow!("{}: {e}", path.display()))?;
         (Start::Resume { checkpoint, path }, path.display().to_string())
     } else {
         match &args.config {
@@ -437,7 +428,7 @@ fn run_simulation(args: RunArgs) -> Result<ExitCode> {
         }
     };
     let options = RunOptions { force: args.force, interrupt_after: args.interrupt_after };
-    let summary = run_into(start, &args.out, options, &stop, progress).map_err(|e| match e {
+    let summary = run_into::<2>(start, &args.out, options, &stop, progress).map_err(|e| match e {
         // A bad configuration, initial state or checkpoint: name where it came from.
         RunFailure::Run(e) => anyhow::anyhow!("{source}: {e}"),
         RunFailure::Output(e) => anyhow::anyhow!("{e}"),
@@ -492,7 +483,7 @@ fn run_simulation(args: RunArgs) -> Result<ExitCode> {
 fn validate(args: ValidateArgs) -> Result<ExitCode> {
     use collide::lab::{Options, check::table, report::validate};
     let options = Options { quick: args.quick, seed: args.seed, out: args.out };
-    let results = validate(&options, |name| eprintln!("running {name} …")).map_err(anyhow::Error::msg)?;
+    let results = validate(&options, |name| eprintln!("running {name} …"))?;
     for r in &results {
         say!("{}", table(&r.name, &r.checks).trim_end());
     }
@@ -508,8 +499,8 @@ fn validate(args: ValidateArgs) -> Result<ExitCode> {
 }
 
 fn bench(args: BenchArgs) -> Result<ExitCode> {
-    use collide::io::output::write_atomic;
-    use collide::lab::bench::{BenchPoint, chart, markdown, matrix};
+    use collide::bench::{BenchPoint, chart, markdown, matrix};
+    use collide::run::output::write_atomic;
     let (points, warmup, timed) = matrix(args.quick);
     let exe = std::env::current_exe().context("locating the collide binary")?;
     let mut results = Vec::new();
@@ -535,8 +526,7 @@ fn bench(args: BenchArgs) -> Result<ExitCode> {
     let md = markdown(&results, &command, &collide::lab::report::machine());
     write_atomic(&args.out.join("bench.json"), serde_json::to_string_pretty(&results)?.as_bytes())?;
     write_atomic(&args.out.join("bench.md"), md.as_bytes())?;
-    collide::lab::plot::draw(&chart(&results), &args.out.join("collisions_per_second.svg"))
-        .map_err(anyhow::Error::msg)?;
+    collide::lab::plot::draw(&chart(&results), &args.out.join("collisions_per_second.svg"))?;
     say!("{}", md.trim_end());
     say!("results in {}", args.out.display());
     Ok(ExitCode::SUCCESS)

@@ -155,7 +155,7 @@ fn checkpoint_for(case: &Case, dir: &Path) -> PathBuf {
         }
     }
     let out = if case.reseal {
-        let saved: Saved = serde_json::from_value(value["run"].clone())
+        let saved: Saved<2> = serde_json::from_value(value["run"].clone())
             .unwrap_or_else(|e| panic!("{}: the edit does not make a state: {e}", case.name));
         Checkpoint::seal(saved).to_json()
     } else {

@@ -225,7 +225,7 @@ fn sampling_below_clock_resolution_does_not_hang() {
 /// it: its lanes put the predicted particle first whatever the indices.
 #[test]
 fn pair_predictions_do_not_depend_on_the_order_of_the_pair() {
-    use collide::engine::events::{bracket_pair, predict_pair};
+    use collide::engine::sources::pair::{bracket as bracket_pair, predict as predict_pair};
     use rand::rngs::Xoshiro256PlusPlus;
     use rand::{RngExt, SeedableRng};
     let mut rng = Xoshiro256PlusPlus::seed_from_u64(7);

@@ -9,10 +9,9 @@
 
 mod common;
 
-use collide::io::config::Config;
-use collide::io::numbers::NumberFormat;
-use collide::io::query::{Query, answer_lines};
-use collide::run::{Checkpoint, Limits, Run, Saved, Sink, Status};
+use collide::query::numbers::NumberFormat;
+use collide::query::{Query, answer_lines};
+use collide::run::{Checkpoint, Config, Discard, Limits, Run, Saved, Sink, Status};
 use common::BASE;
 use proptest::prelude::*;
 use proptest::test_runner::{Config as ProptestConfig, RngAlgorithm, TestRng, TestRunner};
@@ -121,9 +120,9 @@ struct Budget<'a> {
     stop: &'a AtomicBool,
 }
 
-impl Sink for Budget<'_> {
+impl Sink<2> for Budget<'_> {
     type Error = ();
-    fn event(&mut self, _: &collide::run::Run, _: &collide::engine::Outcome<2>) -> Result<(), ()> {
+    fn event(&mut self, _: &Run<2>, _: &collide::engine::Outcome<2>) -> Result<(), ()> {
         self.events += 1;
         if self.events >= EVENTS {
             self.stop.store(true, Ordering::Relaxed);
@@ -147,7 +146,11 @@ fn strict_json(text: &str) -> Result<(), TestCaseError> {
 
 /// Counts a run that was refused or admitted (and exercises it): the generators must reach
 /// both sides, or they test half of the property.
-fn judge(run: Result<Run, impl std::fmt::Display>, refused: &Cell<u32>, ran: &Cell<u32>) -> Result<(), TestCaseError> {
+fn judge(
+    run: Result<Run<2>, impl std::fmt::Display>,
+    refused: &Cell<u32>,
+    ran: &Cell<u32>,
+) -> Result<(), TestCaseError> {
     match run {
         Ok(run) => {
             ran.set(ran.get() + 1);
@@ -168,7 +171,7 @@ fn both_sides(refused: Cell<u32>, ran: Cell<u32>) {
 
 /// Runs a run that was admitted: a bounded number of events, then the summary and the
 /// checkpoint must be strict JSON, and the checkpoint must be accepted again.
-fn exercise(mut run: Run) -> Result<(), TestCaseError> {
+fn exercise(mut run: Run<2>) -> Result<(), TestCaseError> {
     let stop = AtomicBool::new(false);
     let mut budget = Budget { events: 0, stop: &stop };
     let status = run.advance(&stop, &mut budget).expect("the budget never fails");
@@ -177,7 +180,7 @@ fn exercise(mut run: Run) -> Result<(), TestCaseError> {
     strict_json(&serde_json::to_string(&run.summary()).expect("a summary serialises"))?;
     let text = run.checkpoint(0).to_json();
     strict_json(&text)?;
-    let again = Checkpoint::from_json(text.as_bytes())
+    let again = Checkpoint::<2>::from_json(text.as_bytes())
         .map_err(|e| TestCaseError::fail(format!("own checkpoint refused: {e}")))?;
     Run::resume_with_limits(again, limits())
         .map_err(|e| TestCaseError::fail(format!("own checkpoint refused: {e}")))?;
@@ -256,11 +259,22 @@ fn base_checkpoint() -> &'static serde_json::Value {
     static CHECKPOINT: OnceLock<serde_json::Value> = OnceLock::new();
     CHECKPOINT.get_or_init(|| {
         let config = Config::parse(BASE, "base").unwrap();
-        let mut run = Run::with_limits(config, limits()).unwrap();
-        run.equilibrate(|_| {});
-        while run.collisions() < 5000 {
-            run.step().unwrap();
+        let mut run = Run::<2>::with_limits(config, limits()).unwrap();
+        let Ok(_) = run.equilibrate(&mut Discard);
+        /// Asks the run to stop once production has 5 000 collisions.
+        struct Five<'a>(&'a AtomicBool);
+        impl Sink<2> for Five<'_> {
+            type Error = std::convert::Infallible;
+            fn event(&mut self, run: &Run<2>, _: &collide::engine::Outcome<2>) -> Result<(), Self::Error> {
+                if run.collisions() >= 5000 {
+                    self.0.store(true, Ordering::Relaxed);
+                }
+                Ok(())
+            }
         }
+        let stop = AtomicBool::new(false);
+        let Ok(_) = run.advance(&stop, &mut Five(&stop));
+        assert_eq!(run.collisions(), 5000);
         serde_json::from_str(&run.checkpoint(0).to_json()).unwrap()
     })
 }
@@ -365,12 +379,12 @@ fn mutate_checkpoint(mutations: &[(u32, u32, u32)]) -> serde_json::Value {
 #[test]
 fn mutated_checkpoints_are_refused_by_their_digest() {
     let strategy = prop::collection::vec((any::<u32>(), any::<u32>(), any::<u32>()), 1..3);
-    let saved: Saved = serde_json::from_value(base_checkpoint()["run"].clone()).unwrap();
+    let saved: Saved<2> = serde_json::from_value(base_checkpoint()["run"].clone()).unwrap();
     let original = serde_json::to_string(&saved).unwrap();
     runner(cases(500))
         .run(&strategy, |mutations| {
             let value = mutate_checkpoint(&mutations);
-            match Checkpoint::from_json(serde_json::to_string(&value).unwrap().as_bytes()) {
+            match Checkpoint::<2>::from_json(serde_json::to_string(&value).unwrap().as_bytes()) {
                 Err(e) => short(&e.to_string()),
                 // Accepted only when the mutation changed nothing that is read back.
                 Ok(checkpoint) => {
@@ -389,7 +403,7 @@ fn resealed_mutated_checkpoints_are_refused_clearly_or_run() {
     runner(cases(2000))
         .run(&strategy, |mutations| {
             let value = mutate_checkpoint(&mutations);
-            let Ok(saved) = serde_json::from_value::<Saved>(value["run"].clone()) else {
+            let Ok(saved) = serde_json::from_value::<Saved<2>>(value["run"].clone()) else {
                 refused.set(refused.get() + 1);
                 return Ok(());
             };

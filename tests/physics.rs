@@ -2,10 +2,10 @@
 //! Fixed seeds throughout; every tolerance says where it comes from.
 
 use collide::engine::{Boundary, Outcome, Particle, SimBox, Simulation};
-use collide::io::config::Config;
 use collide::observe::block_error;
-use collide::run::{Checkpoint, Run, Summary};
+use collide::run::{Checkpoint, Config, Discard, Run, Sink, Summary};
 use nalgebra::Vector2;
+use std::sync::atomic::{AtomicBool, Ordering};
 
 const EPS: f64 = f64::EPSILON;
 
@@ -13,12 +13,19 @@ fn config(text: &str) -> Config {
     Config::parse(text, "test").unwrap()
 }
 
-fn run_to_end(mut run: Run) -> (Run, Summary) {
-    while !run.done() {
-        run.step().expect("events keep coming");
-    }
-    let summary = run.summary();
+fn run_to_end(mut run: Run<2>) -> (Run<2>, Summary) {
+    let Ok(_) = run.complete(&mut Discard);
+    assert!(run.done(), "events keep coming");
+    // The wall-clock fields are the only ones a rerun may change.
+    let summary = Summary { wall_time_s: 0.0, collisions_per_second: 0.0, ..run.summary() };
     (run, summary)
+}
+
+/// Equilibrates a run (its production starts, nothing of it is run).
+fn equilibrated(config: Config) -> Run<2> {
+    let mut run = Run::new(config).unwrap();
+    let Ok(_) = run.equilibrate(&mut Discard);
+    run
 }
 
 fn periodic(n: usize, eta: f64, collisions: u64, seed: u64) -> Config {
@@ -38,8 +45,7 @@ fn periodic(n: usize, eta: f64, collisions: u64, seed: u64) -> Config {
 /// can overlap by a few ε·max|r|; 16ε·max|r|/σ covers it.
 #[test]
 fn energy_momentum_and_overlaps_over_a_million_collisions() {
-    let mut run = Run::new(periodic(400, 0.5, 1_000_000, 7)).unwrap();
-    run.equilibrate(|_| {});
+    let run = equilibrated(periodic(400, 0.5, 1_000_000, 7));
     let (p0, k0) = (run.sim.momentum(), run.sim.kinetic_energy());
     let (run, summary) = run_to_end(run);
     let m = summary.collisions as f64;
@@ -58,23 +64,11 @@ fn energy_momentum_and_overlaps_over_a_million_collisions() {
 /// The same configuration and seed give bit-identical results; another seed does not.
 #[test]
 fn same_seed_same_bits() {
-    let a = run_to_end({
-        let mut r = Run::new(periodic(200, 0.6, 50_000, 3)).unwrap();
-        r.equilibrate(|_| {});
-        r
-    });
-    let b = run_to_end({
-        let mut r = Run::new(periodic(200, 0.6, 50_000, 3)).unwrap();
-        r.equilibrate(|_| {});
-        r
-    });
+    let a = run_to_end(equilibrated(periodic(200, 0.6, 50_000, 3)));
+    let b = run_to_end(equilibrated(periodic(200, 0.6, 50_000, 3)));
     assert_eq!(a.1, b.1);
     assert_eq!(a.0.sim.particles(), b.0.sim.particles());
-    let c = run_to_end({
-        let mut r = Run::new(periodic(200, 0.6, 50_000, 4)).unwrap();
-        r.equilibrate(|_| {});
-        r
-    });
+    let c = run_to_end(equilibrated(periodic(200, 0.6, 50_000, 4)));
     assert_ne!(a.1.pressure_virial, c.1.pressure_virial);
 }
 
@@ -83,18 +77,26 @@ fn same_seed_same_bits() {
 #[test]
 fn checkpoint_and_resume_equal_an_uninterrupted_run() {
     let config = periodic(150, 0.55, 40_000, 11);
-    let mut whole = Run::new(config.clone()).unwrap();
-    whole.equilibrate(|_| {});
-    let (whole, expected) = run_to_end(whole);
+    let (whole, expected) = run_to_end(equilibrated(config.clone()));
 
-    let mut first = Run::new(config).unwrap();
-    first.equilibrate(|_| {});
-    while first.collisions() < 17_321 {
-        first.step().unwrap();
+    /// Asks the run to stop once production has `at` collisions.
+    struct StopAt<'a>(u64, &'a AtomicBool);
+    impl Sink<2> for StopAt<'_> {
+        type Error = std::convert::Infallible;
+        fn event(&mut self, run: &Run<2>, _: &Outcome<2>) -> Result<(), Self::Error> {
+            if run.collisions() >= self.0 {
+                self.1.store(true, Ordering::Relaxed);
+            }
+            Ok(())
+        }
     }
+    let mut first = equilibrated(config);
+    let stop = AtomicBool::new(false);
+    let Ok(_) = first.advance(&stop, &mut StopAt(17_321, &stop));
+    assert_eq!(first.collisions(), 17_321);
     let text = first.checkpoint(0).to_json();
     drop(first);
-    let resumed = Run::resume(Checkpoint::from_json(text.as_bytes()).unwrap()).unwrap();
+    let resumed = Run::resume(Checkpoint::<2>::from_json(text.as_bytes()).unwrap()).unwrap();
     let (resumed, got) = run_to_end(resumed);
     assert_eq!(got, expected);
     assert_eq!(resumed.sim.particles(), whole.sim.particles());
@@ -116,9 +118,7 @@ fn walled(n: usize, eta: f64, collisions: u64) -> Config {
 /// the time average up to a boundary term O(σ·p/t), far below the statistical error here.
 #[test]
 fn walled_box_virial_identity() {
-    let mut run = Run::new(walled(300, 0.4, 400_000)).unwrap();
-    run.equilibrate(|_| {});
-    let (run, summary) = run_to_end(run);
+    let (run, summary) = run_to_end(equilibrated(walled(300, 0.4, 400_000)));
     let diffs: Vec<f64> = run
         .thermo
         .samples

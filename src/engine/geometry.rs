@@ -1,5 +1,6 @@
 //! Particles and the box: state, boundaries and the minimum-image convention.
 
+use super::motion;
 use nalgebra::SVector;
 use serde::{Deserialize, Serialize};
 
@@ -45,12 +46,10 @@ impl<const D: usize> SimBox<D> {
     /// (the sign of a zero included).
     ///
     /// Nearly every call asks about two neighbours, whose separation is far from `L/2` and
-    /// `3L/2`; there the answer follows from comparisons, without the division whose latency
-    /// sat on the critical path of every pair prediction (measured at N = 10⁴, η = 0.65, three
-    /// interleaved runs each: median 1.00 → 1.08·10⁶ collisions/s; forcing this function
-    /// inline made the whole loop slower, 0.86, so the compiler decides): `|d| < fl(0.49·L)`
-    /// gives `|fl(d/L)| ≤ 0.49(1 + u)² < ½`, a zero with the sign of `d`; and
-    /// `fl(0.51·L) < |d| < fl(1.49·L)` gives `½ < |fl(d/L)| < 3/2`, one with the sign of `d`.
+    /// `3L/2`; there the answer follows from comparisons, without a division on the critical
+    /// path of every pair prediction: `|d| < fl(0.49·L)` gives `|fl(d/L)| ≤ 0.49(1 + u)² < ½`,
+    /// a zero with the sign of `d`; and `fl(0.51·L) < |d| < fl(1.49·L)` gives
+    /// `½ < |fl(d/L)| < 3/2`, one with the sign of `d`.
     pub fn minimum_image_count(&self, d: &SVector<f64, D>) -> SVector<f64, D> {
         let mut count = SVector::zeros();
         for a in 0..D {
@@ -104,8 +103,7 @@ pub(crate) fn image_count_by_comparison(x: f64, l: f64) -> (f64, bool) {
 /// so a position is never shifted by a box length (which would round).
 ///
 /// In 2D a record is 64 bytes and aligned to 64: exactly one cache line, so that reading a
-/// neighbour (or prefetching it) costs one line where the 72-byte record it replaced
-/// straddled two (measured: +10 % collisions/s at N = 10⁵, η = 0.65; README, Benchmarks).
+/// neighbour costs one line (a record that straddles two lines costs two misses at large N).
 /// In 3D it takes two lines (80 bytes, padded to 128).
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[repr(C, align(64))]
@@ -125,7 +123,7 @@ pub struct Particle<const D: usize> {
     /// Event counter: incremented (modulo 2³²) whenever the velocity changes; an event
     /// predicted with another count is stale. A counter that wraps to 0 makes the
     /// [`Simulation`](super::Simulation) predict every particle again, so that no pending
-    /// event can outlive 2³² changes of its partner and take it for none.
+    /// event can outlive 2³² changes of its partner and take it for a live one.
     pub events: u32,
 }
 
@@ -133,10 +131,10 @@ pub struct Particle<const D: usize> {
 const _: () = assert!(size_of::<Particle<2>>() == 64);
 
 impl<const D: usize> Particle<D> {
-    /// Position at time `t`.
+    /// Position at time `t` (the [motion law](super::motion)).
     #[inline]
     pub fn position_at(&self, t: f64) -> SVector<f64, D> {
-        self.position + self.velocity * (t - self.time)
+        motion::position(&self.position, &self.velocity, t - self.time)
     }
 
     /// Moves the stored state to time `t`.

@@ -13,14 +13,13 @@
 //! * Enskog with Henderson's g(σ), for η ≤ 0.5: |Γ − Γ_E| ≤ 3σ + the 0.5 % accuracy of
 //!   Henderson's Z carried to g (a relative Z/(Z − 1)·0.5 %) + |Γ|/N finite size.
 
-use super::equation_of_state::z_henderson;
 use super::plot::{Chart, Series, draw};
 use super::stats::three_sigma_factor;
-use super::{Check, ExperimentResult, Options};
-use crate::engine::Outcome;
-use crate::io::config::Config;
+use super::{Check, ExperimentError, ExperimentResult, Options, run_to_end};
 use crate::observe::block_error;
-use crate::run::Run;
+use crate::run::{Config, Discard, Run};
+pub use crate::theory::{g_henderson, gamma_enskog};
+use crate::theory::{mean_free_path_enskog, z_henderson};
 use serde::{Deserialize, Serialize};
 use serde_json::json;
 use std::f64::consts::PI;
@@ -51,16 +50,8 @@ pub struct RateState {
     pub mean_free_path: f64,
 }
 
-pub use crate::theory::g_henderson;
-
-/// Enskog's Γ ([`crate::theory::enskog_rate_2d`]) at packing fraction η and contact value g,
-/// for σ = m = kT = 1 (number density n = 4η/π).
-pub fn gamma_enskog(eta: f64, g: f64) -> f64 {
-    crate::theory::enskog_rate_2d(4.0 * eta / PI, 1.0, g, 1.0, 1.0)
-}
-
 /// Measures one state.
-pub fn measure(eta: f64, n: usize, per_particle: u64, seed: u64) -> Result<RateState, String> {
+pub fn measure(eta: f64, n: usize, per_particle: u64, seed: u64) -> Result<RateState, ExperimentError> {
     let production = per_particle * n as u64;
     let mut config = Config::parse(
         &format!(
@@ -69,24 +60,21 @@ pub fn measure(eta: f64, n: usize, per_particle: u64, seed: u64) -> Result<RateS
             production / 2
         ),
         NAME,
-    )
-    .map_err(|e| e.to_string())?;
+    )?;
     config.run.sample_interval = 2.0 * per_particle as f64 / gamma_enskog(eta, g_henderson(eta)) / 200.0;
-    let mut run = Run::new(config).map_err(|e| e.to_string())?;
-    run.equilibrate(|_| {});
-    let (mut last_t, mut last_c) = (run.sim.time(), 0u64);
+    let mut run = Run::<2>::new(config)?;
+    run_to_end(&mut run, &mut Discard)?;
+    // Γ and the identity sample by sample, from the collisions and pressures of each interval.
+    let (mut last_t, mut last_c) = (run.thermo.start_time, 0u64);
     let (mut rates, mut diffs) = (Vec::new(), Vec::new());
-    while !run.done() {
-        if let Outcome::Sample = run.step().ok_or("the gas stopped")? {
-            let s = run.thermo.samples.last().expect("a sample");
-            let rate = 2.0 * (s.collisions - last_c) as f64 / (n as f64 * (s.t - last_t));
-            let density = n as f64 / run.sim.sim_box().volume();
-            let z = s.pressure_virial / (density * s.kt);
-            // Z − 1 = (σΓ/(2d))·√(πm/kT) ⇒ Γ(Z) = 4(Z − 1)·√(kT/(πm)) (d = 2, σ = m = 1).
-            rates.push(rate);
-            diffs.push(rate - 4.0 * (z - 1.0) * (s.kt / PI).sqrt());
-            (last_t, last_c) = (s.t, s.collisions);
-        }
+    let density = n as f64 / run.sim.sim_box().volume();
+    for s in &run.thermo.samples {
+        let rate = 2.0 * (s.collisions - last_c) as f64 / (n as f64 * (s.t - last_t));
+        let z = s.pressure_virial / (density * s.kt);
+        // Z − 1 = (σΓ/(2d))·√(πm/kT) ⇒ Γ(Z) = 4(Z − 1)·√(kT/(πm)) (d = 2, σ = m = 1).
+        rates.push(rate);
+        diffs.push(rate - 4.0 * (z - 1.0) * (s.kt / PI).sqrt());
+        (last_t, last_c) = (s.t, s.collisions);
     }
     let summary = run.summary();
     let (_, gamma_err) = block_error(&rates, 20);
@@ -133,7 +121,7 @@ pub fn checks_for(s: &RateState) -> Vec<Check> {
 }
 
 /// Runs the experiment.
-pub fn run(options: &Options) -> Result<ExperimentResult, String> {
+pub fn run(options: &Options) -> Result<ExperimentResult, ExperimentError> {
     let (n, per_particle, etas) =
         if options.quick { (400, 200, vec![0.2, 0.5]) } else { (1600, 500, vec![0.1, 0.2, 0.3, 0.4, 0.5, 0.6, 0.65]) };
     let mut states = Vec::new();
@@ -141,8 +129,7 @@ pub fn run(options: &Options) -> Result<ExperimentResult, String> {
         states.push(measure(eta, n, per_particle, options.seed + k as u64)?);
     }
     let checks: Vec<Check> = states.iter().flat_map(checks_for).collect();
-    let dir = ExperimentResult::dir(&options.out, NAME);
-    std::fs::create_dir_all(&dir).map_err(|e| format!("{}: {e}", dir.display()))?;
+    let dir = ExperimentResult::plot_dir(&options.out, NAME)?;
     let top = etas.iter().copied().fold(0.0, f64::max) + 0.02;
     let chart = Chart {
         title: "Collision frequency per particle".into(),
@@ -175,7 +162,7 @@ pub fn run(options: &Options) -> Result<ExperimentResult, String> {
         data: json!({
             "states": states,
             "enskog_henderson": states.iter().map(|s| gamma_enskog(s.eta, g_henderson(s.eta))).collect::<Vec<_>>(),
-            "mean_free_path_enskog": states.iter().map(|s| 1.0 / (2.0 * 2f64.sqrt() * 4.0 * s.eta / PI * g_henderson(s.eta))).collect::<Vec<_>>(),
+            "mean_free_path_enskog": states.iter().map(|s| mean_free_path_enskog(s.eta)).collect::<Vec<_>>(),
         }),
         checks,
         plots: vec!["collision_rate.svg".into()],

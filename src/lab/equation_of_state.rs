@@ -12,6 +12,8 @@
 //! * the virial series Z = 1 + Σ b_k η^(k−1), b₂…b₁₀ from Clisby & McCoy, J. Stat. Phys. 122,
 //!   15 (2006), Table 1 (D = 2): excellent below η ≈ 0.2.
 //!
+//! (The formulas are in [`crate::theory`].)
+//!
 //! Checks: η ≤ 0.2 against the virial series, 0.2 < η ≤ 0.5 against Henderson. Tolerance:
 //! the 3σ-equivalent for an error estimated from 20 blocks (Student t: 3.45 standard
 //! errors), plus the reference's own accuracy (0.5 % for Henderson; the first
@@ -21,41 +23,20 @@
 //! accuracy there, and above η ≈ 0.69 the liquid–hexatic transition (Bernard & Krauth 2011)
 //! brings slow equilibration and strong finite-size effects.
 
-use super::collision_rate::{g_henderson, gamma_enskog};
 use super::plot::{Chart, Series, draw};
 use super::stats::three_sigma_factor;
-use super::{Check, ExperimentResult, Options};
-use crate::io::config::Config;
-use crate::run::Run;
+use super::{Check, ExperimentError, ExperimentResult, Options, run_to_end};
+use crate::run::{Config, Discard, Run};
+use crate::theory::{g_henderson, gamma_enskog};
+pub use crate::theory::{z_henderson, z_slhy, z_virial};
 use serde::{Deserialize, Serialize};
 use serde_json::json;
 
 /// The experiment's name.
 pub const NAME: &str = "equation_of_state";
 
-/// Close packing of disks, π/(2√3).
-pub const ETA_CP: f64 = 0.906_899_682_117_108_9;
-
-/// Reduced virial coefficients b₂…b₁₀ (Clisby & McCoy 2006, Table 1, D = 2).
-pub const VIRIAL_B: [f64; 9] = [2.0, 3.128018, 4.257854, 5.336897, 6.36296, 7.35186, 8.31910, 9.27214, 10.2163];
-
 /// Blocks for the error bars of every state.
 pub const BLOCKS: usize = 20;
-
-/// Henderson (1975).
-pub fn z_henderson(eta: f64) -> f64 {
-    (1.0 + eta * eta / 8.0) / (1.0 - eta).powi(2)
-}
-
-/// Santos, López de Haro & Yuste (1995).
-pub fn z_slhy(eta: f64) -> f64 {
-    1.0 / (1.0 - 2.0 * eta + (2.0 * ETA_CP - 1.0) * eta * eta / (ETA_CP * ETA_CP))
-}
-
-/// The virial series through b₁₀.
-pub fn z_virial(eta: f64) -> f64 {
-    1.0 + VIRIAL_B.iter().enumerate().map(|(k, b)| b * eta.powi(k as i32 + 1)).sum::<f64>()
-}
 
 /// One measured state.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
@@ -106,7 +87,7 @@ pub fn check_point(p: &Point) -> Option<Check> {
 }
 
 /// Runs one state point.
-pub fn measure(eta: f64, n: usize, equilibration: u64, production: u64, seed: u64) -> Result<Point, String> {
+pub fn measure(eta: f64, n: usize, equilibration: u64, production: u64, seed: u64) -> Result<Point, ExperimentError> {
     // The sampling interval (time between rows) is a few mean free times; Enskog's estimate
     // with Henderson's contact value sets it (only for scheduling).
     let tau = 1.0 / gamma_enskog(eta, g_henderson(eta));
@@ -118,12 +99,8 @@ pub fn measure(eta: f64, n: usize, equilibration: u64, production: u64, seed: u6
          [run]\ncollisions = {production}\nsample_interval = {}\nblocks = 20\n",
         run_time / samples_wanted
     );
-    let config = Config::parse(&text, "equation_of_state").map_err(|e| e.to_string())?;
-    let mut run = Run::new(config).map_err(|e| e.to_string())?;
-    run.equilibrate(|_| {});
-    while !run.done() {
-        run.step().ok_or("the gas stopped")?;
-    }
+    let mut run = Run::<2>::new(Config::parse(&text, NAME)?)?;
+    run_to_end(&mut run, &mut Discard)?;
     let s = run.summary();
     Ok(Point {
         eta,
@@ -136,7 +113,7 @@ pub fn measure(eta: f64, n: usize, equilibration: u64, production: u64, seed: u6
 }
 
 /// Runs the experiment.
-pub fn run(options: &Options) -> Result<ExperimentResult, String> {
+pub fn run(options: &Options) -> Result<ExperimentResult, ExperimentError> {
     let (n, etas, per_particle): (usize, Vec<f64>, u64) = if options.quick {
         (256, vec![0.1, 0.3, 0.5, 0.65], 200)
     } else {
@@ -150,8 +127,7 @@ pub fn run(options: &Options) -> Result<ExperimentResult, String> {
     }
     let checks: Vec<Check> = points.iter().filter_map(check_point).collect();
 
-    let dir = ExperimentResult::dir(&options.out, NAME);
-    std::fs::create_dir_all(&dir).map_err(|e| format!("{}: {e}", dir.display()))?;
+    let dir = ExperimentResult::plot_dir(&options.out, NAME)?;
     let curve =
         |f: fn(f64) -> f64, top: f64| (0..=140).map(|k| k as f64 * top / 140.0).map(|e| (e, f(e))).collect::<Vec<_>>();
     let top = etas.iter().copied().fold(0.0, f64::max) + 0.01;

@@ -20,10 +20,11 @@
 
 use super::plot::{Chart, Series, draw};
 use super::stats::three_sigma_factor;
-use super::{Check, ExperimentResult, Options};
-use crate::engine::init::{Placement, Species, Velocities, box_for_packing_fraction, initial_particles};
-use crate::engine::{Boundary, Outcome, Simulation};
-use crate::observe::block_error;
+use super::{Check, ExperimentError, ExperimentResult, Options, run_to_end};
+use crate::engine::init::{Placement, Velocities, initial_particles};
+use crate::engine::{Outcome, Simulation};
+use crate::observe::{Observer, block_error};
+use crate::run::{Config, Discard, Run, box_of};
 use serde_json::json;
 
 /// The experiment's name.
@@ -41,6 +42,21 @@ pub fn species_temperatures(sim: &Simulation<2>, species: usize) -> Vec<f64> {
     k.iter().zip(&dof).map(|(k, d)| 2.0 * k / d).collect()
 }
 
+/// The species temperatures at every sample, in mean free times `tau`.
+struct SpeciesTemperatures {
+    tau: f64,
+    series: Vec<[f64; 3]>,
+}
+
+impl Observer<2> for SpeciesTemperatures {
+    fn observe(&mut self, sim: &Simulation<2>, outcome: &Outcome<2>) {
+        if let Outcome::Sample = outcome {
+            let t = species_temperatures(sim, 2);
+            self.series.push([sim.time() / self.tau, t[0], t[1]]);
+        }
+    }
+}
+
 /// One mixture: returns (times, kT_A, kT_B) and the check.
 pub fn relax(
     radii: [f64; 2],
@@ -48,14 +64,22 @@ pub fn relax(
     mean_free_times: f64,
     seed: u64,
     label: &str,
-) -> Result<(Vec<[f64; 3]>, Check), String> {
-    let species = vec![
-        Species { count: n / 2, radius: radii[0], mass: 1.0 },
-        Species { count: n - n / 2, radius: radii[1], mass: 10.0 },
-    ];
-    let sim_box = box_for_packing_fraction(&species, 0.3, [Boundary::Periodic; 2], Placement::Triangular, None);
-    let mut particles = initial_particles(&species, &sim_box, Placement::Triangular, Velocities::Maxwell, 1.0, seed)
-        .map_err(|e| e.to_string())?;
+) -> Result<(Vec<[f64; 3]>, Check), ExperimentError> {
+    // The equilibration is a warm-up of n collisions that measures the mean free time; the
+    // production, planned from it, samples once per mean free time.
+    let text = format!(
+        "seed = {seed}\n[box]\npacking_fraction = 0.3\nboundary = \"periodic\"\n\
+         [[species]]\ncount = {}\nradius = {:?}\nmass = 1.0\n[[species]]\ncount = {}\nradius = {:?}\nmass = 10.0\n\
+         [equilibration]\ncollisions = {n}\n[run]\ncollisions = 1\n",
+        n / 2,
+        radii[0],
+        n - n / 2,
+        radii[1]
+    );
+    let config = Config::parse(&text, NAME)?;
+    let sim_box = box_of::<2>(&config);
+    let mut particles =
+        initial_particles(&config.species, &sim_box, Placement::Triangular, Velocities::Maxwell, 1.0, seed)?;
     // Heat A to kT = 2 and cool B to kT = 0.5 (the total momentum stays zero only on average;
     // remove it again, then the species temperatures are as set to O(1/N)).
     for p in particles.iter_mut() {
@@ -66,24 +90,15 @@ pub fn relax(
     for p in particles.iter_mut() {
         p.velocity -= momentum / total_mass;
     }
-    let mut sim = Simulation::new(particles, sim_box).map_err(|e| e.to_string())?;
-    // One sample per mean free time, estimated from the first collisions.
-    let warm = n as u64;
-    while sim.counts().pair < warm {
-        sim.step().ok_or("the gas stopped")?;
-    }
-    let tau = n as f64 * sim.time() / (2.0 * warm as f64);
-    sim.sample_every(tau);
-    let mut series = vec![{
-        let t = species_temperatures(&sim, 2);
-        [sim.time() / tau, t[0], t[1]]
-    }];
-    while sim.time() < mean_free_times * tau {
-        if let Outcome::Sample = sim.step().ok_or("the gas stopped")? {
-            let t = species_temperatures(&sim, 2);
-            series.push([sim.time() / tau, t[0], t[1]]);
-        }
-    }
+    let mut run = Run::<2>::from_particles(config, particles)?;
+    let Ok(_) = run.equilibrate(&mut Discard);
+    let warm = run.sim.counts().pair;
+    let tau = n as f64 * run.sim.time() / (2.0 * warm as f64);
+    run.plan_production(None, Some(mean_free_times * tau - run.sim.time()), tau)?;
+    let t = species_temperatures(&run.sim, 2);
+    let mut observer = SpeciesTemperatures { tau, series: vec![[run.sim.time() / tau, t[0], t[1]]] };
+    run_to_end(&mut run, &mut observer)?;
+    let series = observer.series;
     let late: Vec<f64> = series[series.len() / 2..].iter().map(|s| s[1] - s[2]).collect();
     let (mean, error) = block_error(&late, 20);
     let check = Check::within(
@@ -98,7 +113,7 @@ pub fn relax(
 }
 
 /// Runs the experiment.
-pub fn run(options: &Options) -> Result<ExperimentResult, String> {
+pub fn run(options: &Options) -> Result<ExperimentResult, ExperimentError> {
     // The length is set by the statistics (see the module docs), the size by the budget.
     let (n, horizon) = if options.quick { (400, 2000.0) } else { (2000, 2000.0) };
     let cases = [("equal radii", [0.5, 0.5]), ("radii 0.5 and 0.35", [0.5, 0.35])];
@@ -114,8 +129,7 @@ pub fn run(options: &Options) -> Result<ExperimentResult, String> {
         data.push(json!({ "case": label, "radii": radii, "series": series }));
         checks.push(check);
     }
-    let dir = ExperimentResult::dir(&options.out, NAME);
-    std::fs::create_dir_all(&dir).map_err(|e| format!("{}: {e}", dir.display()))?;
+    let dir = ExperimentResult::plot_dir(&options.out, NAME)?;
     draw(
         &Chart {
             title: "Equipartition in a binary mixture (mass ratio 1:10)".into(),

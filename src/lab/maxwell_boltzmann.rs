@@ -14,40 +14,22 @@
 //! A true Maxwellian fails the KS check with probability 5 % and each 3σ check with 0.3 %;
 //! the seed is fixed, so the verdict is reproducible.
 
-use super::collision_rate::{g_henderson, gamma_enskog};
 use super::plot::{Chart, Series, draw};
-use super::stats::{h_function, histogram, ks_critical_95, ks_rayleigh, kurtosis, sonine_a2, speed_bins};
-use super::{Check, ExperimentResult, Options};
-use crate::engine::init::{Placement, Species, Velocities, box_for_packing_fraction, initial_particles};
-use crate::engine::{Boundary, Outcome, Simulation};
-use serde::{Deserialize, Serialize};
+use super::stats::ks_critical_95;
+use super::{Check, ExperimentError, ExperimentResult, Options, run_to_end};
+use crate::observe::Observable;
+use crate::observe::velocities::{self, Snapshot, histogram};
+use crate::run::{Config, Discard, Run};
+use crate::theory::{g_henderson, gamma_enskog};
 use serde_json::json;
 
 /// The experiment's name (binary, directory).
 pub const NAME: &str = "maxwell_boltzmann";
 
-/// The statistics of one snapshot of the velocities.
-#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
-pub struct Metrics {
-    /// Simulated time.
-    pub t: f64,
-    /// KS distance to the Rayleigh CDF.
-    pub ks: f64,
-    /// H − H_eq (bias-corrected KL divergence).
-    pub h: f64,
-    /// Its standard deviation for a Maxwellian.
-    pub h_error: f64,
-    /// Sonine coefficient a₂.
-    pub sonine_a2: f64,
-    /// Its standard error.
-    pub sonine_a2_error: f64,
-    /// Kurtosis of the velocity components.
-    pub kurtosis: f64,
-    /// Its standard error.
-    pub kurtosis_error: f64,
-}
+/// The statistics of one snapshot of the velocities (the observable's [`Snapshot`]).
+pub type Metrics = Snapshot;
 
-/// Speeds and components in units of √(kT/m) from velocities (equal masses m).
+/// Speeds and components in units of √(kT/m) from 2D velocities (equal masses m).
 pub fn reduced(velocities: &[[f64; 2]], kt_over_m: f64) -> (Vec<f64>, Vec<f64>) {
     let s = kt_over_m.sqrt();
     let speeds = velocities.iter().map(|v| (v[0] * v[0] + v[1] * v[1]).sqrt() / s).collect();
@@ -55,12 +37,9 @@ pub fn reduced(velocities: &[[f64; 2]], kt_over_m: f64) -> (Vec<f64>, Vec<f64>) 
     (speeds, components)
 }
 
-/// The statistics of one snapshot.
+/// The statistics of one 2D snapshot.
 pub fn metrics(t: f64, speeds: &[f64], components: &[f64]) -> Metrics {
-    let (h, h_error) = h_function(speeds);
-    let (sonine_a2, sonine_a2_error) = sonine_a2(speeds);
-    let (kurtosis, kurtosis_error) = kurtosis(components);
-    Metrics { t, ks: ks_rayleigh(speeds), h, h_error, sonine_a2, sonine_a2_error, kurtosis, kurtosis_error }
+    Snapshot::of(t, 2, speeds, components)
 }
 
 /// The checks, from the first and last snapshots of `n` disks.
@@ -108,49 +87,38 @@ pub fn checks(first: &Metrics, last: &Metrics, n: usize) -> Vec<Check> {
 }
 
 /// Runs the experiment.
-pub fn run(options: &Options) -> Result<ExperimentResult, String> {
+pub fn run(options: &Options) -> Result<ExperimentResult, ExperimentError> {
     let (n, horizon) = if options.quick { (2000, 20.0) } else { (20000, 30.0) };
     let eta: f64 = 0.3;
-    let species = vec![Species { count: n, radius: 0.5, mass: 1.0 }];
-    let sim_box = box_for_packing_fraction(&species, eta, [Boundary::Periodic; 2], Placement::Triangular, None);
-    let particles =
-        initial_particles(&species, &sim_box, Placement::Triangular, Velocities::FixedSpeed, 1.0, options.seed)
-            .map_err(|e| e.to_string())?;
-    let mut sim = Simulation::new(particles, sim_box).map_err(|e| e.to_string())?;
     // Enskog's mean free time, only to schedule the snapshots: Γ = 2nσ·g(σ)·√(πkT/m) with
     // Henderson's g(σ) = (1 − 7η/16)/(1 − η)² (physics reference sheet).
     let tau_enskog = 1.0 / gamma_enskog(eta, g_henderson(eta));
-    sim.sample_every(tau_enskog / 4.0);
-
-    let snapshot = |sim: &Simulation<2>| {
-        let v: Vec<[f64; 2]> = sim.particles().iter().map(|p| [p.velocity[0], p.velocity[1]]).collect();
-        reduced(&v, sim.kt())
-    };
-    let edges = speed_bins();
-    let mut series = Vec::new();
-    let mut histograms = Vec::new();
-    let (u, c) = snapshot(&sim);
-    series.push(metrics(sim.time(), &u, &c));
-    histograms.push((0.0, histogram(&u, &edges)));
     let t_end = horizon * tau_enskog;
-    while sim.time() < t_end {
-        if let Outcome::Sample = sim.step().ok_or("the gas stopped")? {
-            let (u, c) = snapshot(&sim);
-            series.push(metrics(sim.time(), &u, &c));
-            if [4, 12, 40].contains(&(series.len() - 1)) {
-                histograms.push((sim.time(), histogram(&u, &edges)));
-            }
-        }
-    }
-    let (u, _) = snapshot(&sim);
-    histograms.push((sim.time(), histogram(&u, &edges)));
+    // No equilibration: the relaxation itself is the production, sampled every τ/4, with the
+    // velocity distribution observed at the start and at every sample.
+    let text = format!(
+        "seed = {}\n[box]\npacking_fraction = {eta}\nboundary = \"periodic\"\n[[species]]\ncount = {n}\nradius = 0.5\nmass = 1.0\n\
+         [init]\nplacement = \"triangular\"\nvelocities = \"fixed-speed\"\n\
+         [run]\ntime = {t_end:?}\nsample_interval = {:?}\n[observe.velocities]\nhistograms_at = [0, 4, 12, 40]\n",
+        options.seed,
+        tau_enskog / 4.0
+    );
+    let mut run = Run::<2>::new(Config::parse(&text, NAME)?)?;
+    run_to_end(&mut run, &mut Discard)?;
+    let sim = &run.sim;
+    let Some(Observable::Velocities(observed)) = run.observables.first() else {
+        return Err(ExperimentError::Missing("the velocity observable"));
+    };
+    let (series, edges) = (&observed.snapshots, &observed.edges);
+    let mut histograms: Vec<(f64, Vec<usize>)> = observed.histograms.iter().map(|h| (h.t, h.counts.clone())).collect();
+    let (u, _) = velocities::reduced(sim);
+    histograms.push((sim.time(), histogram(&u, edges)));
     let collisions = sim.counts().pair;
     let tau = n as f64 * sim.time() / (2.0 * collisions as f64);
     let checks = checks(&series[0], series.last().expect("snapshots"), n);
 
     // Plots.
-    let dir = ExperimentResult::dir(&options.out, NAME);
-    std::fs::create_dir_all(&dir).map_err(|e| format!("{}: {e}", dir.display()))?;
+    let dir = ExperimentResult::plot_dir(&options.out, NAME)?;
     let in_tau = |t: f64| t / tau;
     let width = edges[1] - edges[0];
     // t = 0 is a delta at u = √2 (every speed equal): left out so the scale shows the rest.

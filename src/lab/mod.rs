@@ -1,16 +1,24 @@
 //! The lab: physics experiments that check consequences of the dynamics against theory,
 //! each writing `result.json` (parameters, data, checks with verdicts) and SVG plots.
 //!
-//! Every experiment takes [`Options`] (`quick` for a CI-sized run, a seed, an output
-//! directory), returns an [`ExperimentResult`], and is also a binary
-//! (`cargo run --release --bin <name>`) through [`main_for`].
+//! An experiment is one file: a [`Run`](crate::run::Run) (or several) of a configuration it
+//! writes, observed by the run's own observers and its own ([`crate::observe::Observer`]),
+//! turned into [`Check`]s against the formulas of [`crate::theory`] with tolerances that say
+//! why. Every experiment takes [`Options`] (`quick` for a CI-sized run, a seed, an output
+//! directory) and returns an [`ExperimentResult`]; `collide validate` runs them all
+//! ([`report`]), `collide experiment NAME` one, and each registered in Cargo.toml is also a
+//! binary (`cargo run --release --bin <name>`, through [`main_for`]). What each checks, and
+//! against which reference, is specified in `docs/experiments.md`.
+//!
+//! # Adding an experiment
+//!
+//! Its file here, with `NAME` and `run(&Options)`; then its line in [`EXPERIMENTS`] below
+//! (and `pub mod`). A binary of its own is one more `[[bin]]` entry in Cargo.toml.
 
-pub mod bench;
 pub mod check;
 pub mod collision_rate;
 pub mod equation_of_state;
 pub mod equipartition;
-pub mod floor;
 pub mod maxwell_boltzmann;
 pub mod plot;
 pub mod report;
@@ -19,10 +27,101 @@ pub mod wall_pressure;
 
 pub use check::Check;
 
-use crate::io::output::{OutputError, write_atomic};
+use crate::engine::SetupError;
+use crate::engine::init::InitError;
+use crate::run::output::{OutputError, write_atomic};
+use crate::run::{ConfigError, Invalid, RunError, Stall};
 use serde::{Deserialize, Serialize};
+use std::fmt;
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
+
+/// Every experiment, in report order: its name (its directory, its binary) and its entry
+/// point.
+pub const EXPERIMENTS: &[(&str, Experiment)] = &[
+    (maxwell_boltzmann::NAME, maxwell_boltzmann::run),
+    (wall_pressure::NAME, wall_pressure::run),
+    (equation_of_state::NAME, equation_of_state::run),
+    (collision_rate::NAME, collision_rate::run),
+    (equipartition::NAME, equipartition::run),
+];
+
+/// Why an experiment could not finish (its checks failing is not an error: they are in the
+/// result).
+#[non_exhaustive]
+#[derive(Debug)]
+pub enum ExperimentError {
+    /// A configuration it wrote is invalid.
+    Config(ConfigError),
+    /// A production plan is invalid.
+    Plan(Invalid),
+    /// A run could not start.
+    Run(RunError),
+    /// An initial state could not be built.
+    Init(InitError),
+    /// A prepared state is not valid.
+    Setup(SetupError),
+    /// Nothing could happen any more before the run's length (at simulated time `at`).
+    Stopped {
+        /// The clock when the gas stopped.
+        at: f64,
+    },
+    /// The watchdog stopped a run.
+    Stalled(Stall),
+    /// A file could not be written.
+    Output(OutputError),
+    /// A plot could not be drawn.
+    Plot(plot::PlotError),
+    /// A result it needs is missing.
+    Missing(&'static str),
+}
+
+impl fmt::Display for ExperimentError {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self {
+            ExperimentError::Config(e) => write!(f, "{e}"),
+            ExperimentError::Plan(e) => write!(f, "{e}"),
+            ExperimentError::Run(e) => write!(f, "{e}"),
+            ExperimentError::Init(e) => write!(f, "{e}"),
+            ExperimentError::Setup(e) => write!(f, "{e}"),
+            ExperimentError::Stopped { at } => write!(f, "the gas stopped at t = {at} before the run's length"),
+            ExperimentError::Stalled(stall) => write!(f, "{stall}"),
+            ExperimentError::Output(e) => write!(f, "{e}"),
+            ExperimentError::Plot(e) => write!(f, "{e}"),
+            ExperimentError::Missing(what) => write!(f, "{what}"),
+        }
+    }
+}
+
+impl std::error::Error for ExperimentError {}
+
+macro_rules! from {
+    ($($source:ty => $variant:ident),*) => {
+        $(impl From<$source> for ExperimentError {
+            fn from(e: $source) -> Self {
+                ExperimentError::$variant(e)
+            }
+        })*
+    };
+}
+from!(ConfigError => Config, Invalid => Plan, RunError => Run, InitError => Init, SetupError => Setup,
+      OutputError => Output, plot::PlotError => Plot);
+
+/// Runs `run` to the end of its production with `sink` and says whether it got there: a run
+/// stopped by its watchdog, or one in which nothing can happen any more, is an error.
+pub fn run_to_end<const D: usize, S: crate::run::Sink<D, Error = std::convert::Infallible>>(
+    run: &mut crate::run::Run<D>,
+    sink: &mut S,
+) -> Result<(), ExperimentError> {
+    let Ok(status) = run.complete(sink);
+    if let (crate::run::Status::Stalled, Some(stall)) = run.ended() {
+        return Err(ExperimentError::Stalled(stall.clone()));
+    }
+    if status == crate::run::Status::Complete && !run.done() {
+        return Err(ExperimentError::Stopped { at: run.sim.time() });
+    }
+    Ok(())
+}
 
 /// How to run an experiment.
 #[derive(Clone, Debug, PartialEq)]
@@ -65,17 +164,24 @@ impl ExperimentResult {
         out.join(name)
     }
 
+    /// The experiment's own directory under `out`, created for its plots.
+    pub fn plot_dir(out: &Path, name: &str) -> Result<PathBuf, ExperimentError> {
+        let dir = ExperimentResult::dir(out, name);
+        std::fs::create_dir_all(&dir).map_err(crate::run::rundir::at(&dir))?;
+        Ok(dir)
+    }
+
     /// Writes `result.json` (atomically) into the experiment's directory.
     pub fn write(&self, out: &Path) -> Result<(), OutputError> {
         let dir = ExperimentResult::dir(out, &self.name);
-        std::fs::create_dir_all(&dir).map_err(crate::io::rundir::at(&dir))?;
+        std::fs::create_dir_all(&dir).map_err(crate::run::rundir::at(&dir))?;
         let text = serde_json::to_string_pretty(self).expect("results serialise");
         write_atomic(&dir.join("result.json"), text.as_bytes())
     }
 }
 
 /// An experiment's entry point.
-pub type Experiment = fn(&Options) -> Result<ExperimentResult, String>;
+pub type Experiment = fn(&Options) -> Result<ExperimentResult, ExperimentError>;
 
 /// The options of an experiment on the command line (`--quick`, `--seed`, `--out`): the
 /// experiment binaries and `collide experiment` take the same.
@@ -113,7 +219,7 @@ pub fn main_for(name: &str, experiment: Experiment) -> ExitCode {
 /// Runs one experiment, writes its results, prints the verdict table, and says how it went:
 /// 0 if every check passes, 1 if one fails, 2 on an error.
 pub fn run_one(name: &str, experiment: Experiment, options: &Options) -> ExitCode {
-    match experiment(options).and_then(|r| r.write(&options.out).map(|_| r).map_err(|e| e.to_string())) {
+    match experiment(options).and_then(|r| r.write(&options.out).map(|_| r).map_err(ExperimentError::Output)) {
         Ok(result) => {
             // Writes that fail (stdout closed, e.g. piped into `head`) are not errors of the run.
             use std::io::Write as _;

@@ -2,7 +2,7 @@
 //! needs no system fonts). One helper draws lines, points and error bars on linear axes.
 
 use plotters::prelude::*;
-use std::path::Path;
+use std::path::{Path, PathBuf};
 
 /// How a series is drawn.
 #[derive(Clone, Debug)]
@@ -75,9 +75,26 @@ fn range(values: impl Iterator<Item = f64>) -> (f64, f64) {
     (lo - pad, hi + pad)
 }
 
+/// A chart that could not be drawn: the file, and what plotters said.
+#[derive(Clone, Debug, PartialEq)]
+pub struct PlotError {
+    /// The SVG file.
+    pub path: PathBuf,
+    /// What went wrong.
+    pub reason: String,
+}
+
+impl std::fmt::Display for PlotError {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(f, "{}: {}", self.path.display(), self.reason)
+    }
+}
+
+impl std::error::Error for PlotError {}
+
 /// Draws `chart` into an SVG file at `path`.
-pub fn draw(chart: &Chart, path: &Path) -> Result<(), String> {
-    let err = |e: &dyn std::fmt::Display| format!("{}: {e}", path.display());
+pub fn draw(chart: &Chart, path: &Path) -> Result<(), PlotError> {
+    let err = |e: &dyn std::fmt::Display| PlotError { path: path.to_path_buf(), reason: e.to_string() };
     let (x0, x1) = range(chart.series.iter().flat_map(|s| s.points.iter().map(|p| p.0)));
     let (y0, y1) = range(chart.series.iter().flat_map(|s| {
         let bars: Vec<f64> = match &s.style {

@@ -2,21 +2,9 @@
 //! the verdict table, each check against its expectation and tolerance, the plots, the
 //! machine, the version and the seed.
 
-use super::{
-    Check, Experiment, ExperimentResult, Options, collision_rate, equation_of_state, equipartition, maxwell_boltzmann,
-    wall_pressure,
-};
-use crate::io::output::write_atomic;
+use super::{Check, EXPERIMENTS, ExperimentError, ExperimentResult, Options};
+use crate::run::output::write_atomic;
 use std::fmt::Write as _;
-
-/// Every experiment, in report order.
-pub const EXPERIMENTS: &[(&str, Experiment)] = &[
-    (maxwell_boltzmann::NAME, maxwell_boltzmann::run),
-    (wall_pressure::NAME, wall_pressure::run),
-    (equation_of_state::NAME, equation_of_state::run),
-    (collision_rate::NAME, collision_rate::run),
-    (equipartition::NAME, equipartition::run),
-];
 
 /// The numerics self-check (the edge-case reference) as an experiment-like result.
 pub fn numerics(options: &Options) -> ExperimentResult {
@@ -66,7 +54,7 @@ fn expectation(c: &Check) -> String {
 }
 
 /// Writes `report.md` and `index.html` for these results into `options.out`.
-pub fn write_report(results: &[ExperimentResult], options: &Options) -> Result<(), String> {
+pub fn write_report(results: &[ExperimentResult], options: &Options) -> Result<(), ExperimentError> {
     let passed = results.iter().all(ExperimentResult::passed);
     let header = format!(
         "collide {} · {} · seed {} · {} · {}",
@@ -139,7 +127,7 @@ pub fn write_report(results: &[ExperimentResult], options: &Options) -> Result<(
         for plot in &r.plots {
             writeln!(md, "\n![{plot}]({}/{plot})", r.name).unwrap();
             let path = ExperimentResult::dir(&options.out, &r.name).join(plot);
-            let svg = std::fs::read_to_string(&path).map_err(|e| format!("{}: {e}", path.display()))?;
+            let svg = std::fs::read_to_string(&path).map_err(crate::run::rundir::at(&path))?;
             // Inline: the page is self-contained.
             write!(html, "<figure>{}</figure>", svg.trim_start_matches("<?xml version=\"1.0\" encoding=\"UTF-8\"?>"))
                 .unwrap();
@@ -147,20 +135,20 @@ pub fn write_report(results: &[ExperimentResult], options: &Options) -> Result<(
     }
     html.push_str("</body></html>\n");
     let out = &options.out;
-    std::fs::create_dir_all(out).map_err(|e| format!("{}: {e}", out.display()))?;
-    write_atomic(&out.join("report.md"), md.as_bytes()).map_err(|e| e.to_string())?;
-    write_atomic(&out.join("index.html"), html.as_bytes()).map_err(|e| e.to_string())?;
+    std::fs::create_dir_all(out).map_err(crate::run::rundir::at(out))?;
+    write_atomic(&out.join("report.md"), md.as_bytes())?;
+    write_atomic(&out.join("index.html"), html.as_bytes())?;
     Ok(())
 }
 
 /// Runs the numerics check and every experiment, writes their results and the report, and
 /// returns the results (`progress` hears each experiment's name as it starts).
-pub fn validate(options: &Options, mut progress: impl FnMut(&str)) -> Result<Vec<ExperimentResult>, String> {
+pub fn validate(options: &Options, mut progress: impl FnMut(&str)) -> Result<Vec<ExperimentResult>, ExperimentError> {
     let mut results = vec![numerics(options)];
     for (name, experiment) in EXPERIMENTS {
         progress(name);
         let result = experiment(options)?;
-        result.write(&options.out).map_err(|e| e.to_string())?;
+        result.write(&options.out)?;
         results.push(result);
     }
     write_report(&results, options)?;

@@ -18,15 +18,13 @@
 //!     pressure's 3σ-equivalent and the EOS pressure's (through the density's), in quadrature,
 //!     + 0.5 %.
 
-use super::collision_rate::{g_henderson, gamma_enskog};
-use super::equation_of_state::{z_henderson, z_slhy};
 use super::plot::{Chart, Series, draw};
 use super::stats::{conservative_tolerance, three_sigma_factor};
-use super::{Check, ExperimentResult, Options};
-use crate::engine::{Boundary, Outcome, Particle, SimBox, Simulation};
-use crate::io::config::Config;
-use crate::observe::block_error;
-use crate::run::Run;
+use super::{Check, ExperimentError, ExperimentResult, Options, run_to_end};
+use crate::engine::{Outcome, Particle, Simulation};
+use crate::observe::{Observer, block_error};
+use crate::run::{Config, Run};
+use crate::theory::{g_henderson, gamma_enskog, z_henderson, z_slhy};
 use nalgebra::Vector2;
 use serde::{Deserialize, Serialize};
 use serde_json::json;
@@ -81,33 +79,41 @@ impl WalledState {
     }
 }
 
+/// The number density of the bulk region — every point at least [`BULK_MARGIN`] from every
+/// wall — at every sample.
+struct BulkDensity {
+    lengths: Vector2<f64>,
+    densities: Vec<f64>,
+}
+
+impl Observer<2> for BulkDensity {
+    fn observe(&mut self, sim: &Simulation<2>, outcome: &Outcome<2>) {
+        if let Outcome::Sample = outcome {
+            let (l, m) = (self.lengths, BULK_MARGIN);
+            let inside =
+                sim.wrapped_positions().iter().filter(|r| (0..2).all(|a| r[a] >= m && r[a] <= l[a] - m)).count();
+            self.densities.push(inside as f64 / ((l[0] - 2.0 * m) * (l[1] - 2.0 * m)));
+        }
+    }
+}
+
 /// Runs a walled box of `n` disks at nominal packing fraction `eta`.
-pub fn measure(eta: f64, n: usize, collisions_per_particle: u64, seed: u64) -> Result<WalledState, String> {
+pub fn measure(eta: f64, n: usize, collisions_per_particle: u64, seed: u64) -> Result<WalledState, ExperimentError> {
     let production = collisions_per_particle * n as u64;
     let text = format!(
         "seed = {seed}\n[box]\npacking_fraction = {eta}\nboundary = \"wall\"\n[[species]]\ncount = {n}\nradius = 0.5\nmass = 1.0\n\
          [init]\nplacement = \"square\"\n[equilibration]\ncollisions = {}\n[run]\ncollisions = {production}\nsample_interval = 1.0\n",
         production / 2
     );
-    let mut config = Config::parse(&text, NAME).map_err(|e| e.to_string())?;
+    let mut config = Config::parse(&text, NAME)?;
     // About 200 samples: the sampling interval from Enskog's collision rate (scheduling only).
     let rate = gamma_enskog(eta, g_henderson(eta));
     config.run.sample_interval = 2.0 * collisions_per_particle as f64 / rate / 200.0;
-    let mut run = Run::new(config).map_err(|e| e.to_string())?;
-    run.equilibrate(|_| {});
+    let mut run = Run::<2>::new(config)?;
     let lengths = run.sim.sim_box().lengths;
-    let mut mid = Vec::new();
-    while !run.done() {
-        if let Outcome::Sample = run.step().ok_or("the gas stopped")? {
-            let inside = run
-                .sim
-                .wrapped_positions()
-                .iter()
-                .filter(|r| (0..2).all(|a| r[a] >= BULK_MARGIN && r[a] <= lengths[a] - BULK_MARGIN))
-                .count();
-            mid.push(inside as f64 / ((lengths[0] - 2.0 * BULK_MARGIN) * (lengths[1] - 2.0 * BULK_MARGIN)));
-        }
-    }
+    let mut bulk = BulkDensity { lengths, densities: Vec::new() };
+    run_to_end(&mut run, &mut bulk)?;
+    let mid = bulk.densities;
     let s = run.summary();
     let samples = &run.thermo.samples;
     let walls: Vec<f64> = samples
@@ -138,8 +144,19 @@ pub fn measure(eta: f64, n: usize, collisions_per_particle: u64, seed: u64) -> R
     })
 }
 
+/// The impulse each walled axis received (both walls), summed in the order of the events.
+struct AxisImpulses([f64; 2]);
+
+impl Observer<2> for AxisImpulses {
+    fn observe(&mut self, _: &Simulation<2>, outcome: &Outcome<2>) {
+        if let Outcome::Wall { axis, impulse, .. } = outcome {
+            self.0[*axis] += impulse;
+        }
+    }
+}
+
 /// One disk between walls for a time `t_end`: (½(P_x + P_y), kT/A_acc, tolerance).
-pub fn one_disk(t_end: f64) -> Result<(f64, f64, f64), String> {
+pub fn one_disk(t_end: f64) -> Result<(f64, f64, f64), ExperimentError> {
     let disk = Particle {
         position: Vector2::new(3.1, 2.2),
         velocity: Vector2::new(0.8123, -0.5839),
@@ -150,18 +167,20 @@ pub fn one_disk(t_end: f64) -> Result<(f64, f64, f64), String> {
         events: 0,
     };
     let (lx, ly) = (9.0, 7.0);
-    let sim_box = SimBox { lengths: Vector2::new(lx, ly), boundary: [Boundary::Wall; 2] };
-    let mut sim = Simulation::new(vec![disk.clone()], sim_box).map_err(|e| e.to_string())?;
-    let mut impulse = [0.0; 2];
-    while sim.time() < t_end {
-        if let Outcome::Wall { axis, impulse: j, .. } = sim.step().ok_or("no events")? {
-            impulse[axis] += j;
-        }
-    }
-    let (t, ax, ay) = (sim.time(), lx - 1.0, ly - 1.0);
+    // No equilibration, no samples (the interval is past the end): the run is the flight.
+    let text = format!(
+        "seed = 1\n[box]\nsize = [{lx:?}, {ly:?}]\nboundary = \"wall\"\n[[species]]\ncount = 1\nradius = 0.5\nmass = 1.0\n\
+         [run]\ntime = {t_end:?}\nsample_interval = {:?}\n",
+        2.0 * t_end
+    );
+    let mut run = Run::<2>::from_particles(Config::parse(&text, NAME)?, vec![disk.clone()])?;
+    let mut impulse = AxisImpulses([0.0; 2]);
+    run_to_end(&mut run, &mut impulse)?;
+    let impulse = impulse.0;
+    let (t, ax, ay) = (run.sim.time(), lx - 1.0, ly - 1.0);
     let measured = 0.5 * (impulse[0] / 2.0 / (t * ay) + impulse[1] / 2.0 / (t * ax));
     let tolerance = 0.5 * disk.mass * (disk.velocity.x.abs() / ay + disk.velocity.y.abs() / ax) / t;
-    Ok((measured, sim.kt() / (ax * ay), tolerance))
+    Ok((measured, run.sim.kt() / (ax * ay), tolerance))
 }
 
 /// The ideal-gas check of the one-disk run.
@@ -206,7 +225,7 @@ pub fn identity_check(s: &WalledState) -> Check {
 }
 
 /// Runs the experiment.
-pub fn run(options: &Options) -> Result<ExperimentResult, String> {
+pub fn run(options: &Options) -> Result<ExperimentResult, ExperimentError> {
     let (n, per_particle, etas, t_one) = if options.quick {
         (400, 200, vec![0.2, 0.4], 2.0e4)
     } else {
@@ -218,12 +237,12 @@ pub fn run(options: &Options) -> Result<ExperimentResult, String> {
     for (k, &eta) in etas.iter().enumerate() {
         states.push(measure(eta, n, per_particle, options.seed + k as u64)?);
     }
-    let at_04 = states.iter().find(|s| (s.eta - 0.4).abs() < 1e-12).ok_or("η = 0.4 is always measured")?;
+    let at_04 =
+        states.iter().find(|s| (s.eta - 0.4).abs() < 1e-12).ok_or(ExperimentError::Missing("the state at η = 0.4"))?;
     checks.push(identity_check(at_04));
     checks.extend(states.iter().filter_map(eos_check));
 
-    let dir = ExperimentResult::dir(&options.out, NAME);
-    std::fs::create_dir_all(&dir).map_err(|e| format!("{}: {e}", dir.display()))?;
+    let dir = ExperimentResult::plot_dir(&options.out, NAME)?;
     let top = states.iter().map(|s| s.eta_mid()).fold(0.0, f64::max) + 0.02;
     let eos = |z: fn(f64) -> f64| {
         (1..=120).map(|k| k as f64 * top / 120.0).map(|e| (e, 4.0 * e / PI * z(e))).collect::<Vec<_>>()

@@ -1,24 +1,31 @@
-//! Observables accumulated on the fly from what each resolve reports.
+//! Observers: what a run measures, fed every event's [`Outcome`] as it happens.
 //!
-//! [`Thermo`] is fed every [`Outcome`]: pair collisions add their virial term `σ·|Δp|`,
-//! wall collisions their impulse to their wall, sampling events close a *sample* (one row
-//! of the time series: kinetic energy, temperature and the pressures over the interval).
-//! The estimates of a run use the totals; their error bars come from block averages over
-//! the samples ([`block_error`]).
+//! The push model (as in ripgrep's `Sink`): the [`Run`](crate::run::Run) owns the loop, and
+//! after every event it hands each observer the simulation as the event left it and what the
+//! event did ([`Observer::observe`]). An observer keeps only what it needs — sums, a time
+//! series, histograms — so nothing is stored per event and a run of any length costs the
+//! same memory.
 //!
-//! # Estimators (d = dimension, A = volume, N particles)
+//! * [`Thermo`]: temperature, the collision-virial and wall pressures, the samples of the time
+//!   series (every run has it; its estimators are specified in [`thermo`]).
+//! * The registered observables a configuration names under `[observe.<name>]`
+//!   ([`Selection`]): [`velocities`] (the velocity distribution against the Maxwellian).
+//!   A run keeps them in its checkpoints and reports them in `summary.json`
+//!   (`"observables"`); an experiment can also build any observer itself and hand it to
+//!   [`Run::advance`](crate::run::Run::advance).
 //!
-//! * Temperature: `kT = 2K/dof`, `dof = d·N − (number of periodic axes)` — the total
-//!   momentum along each periodic axis is conserved (and zeroed initially), so it carries no
-//!   thermal energy: `2K/(d(N−1))` in a periodic box, `2K/(dN)` between walls.
-//! * Collision virial: `P·A_acc = N·kT + (1/(d·t))·Σ σ|Δp|`, the sum over pair collisions in
-//!   time `t`, `|Δp|` one partner's momentum change, `σ` the contact distance.
-//!   `A_acc = Π (L − σ̄)` over walled axes and `L` over periodic ones (so `A_acc = A` in a
-//!   periodic box; between walls this is the walled-box virial identity).
-//! * Wall pressure: impulse on one wall per time per *accessible* wall length (area): for
-//!   the wall normal to `x`, `P = Σ|Δp| / (t·(L_y − σ̄))` (2D). For mixtures σ̄ is the
-//!   number-averaged diameter (a convention: each species really has its own accessible
-//!   length `L − σ_s`).
+//! # Adding an observable
+//!
+//! Its file here, with an `Options` type (what `[observe.<name>]` may hold) and a type that
+//! implements [`Observer`] and serde's traits; then, in this file: `pub mod`, its field of
+//! [`Selection`], its variant of [`Observable`], and its line in each match below.
+
+pub mod blocks;
+pub mod thermo;
+pub mod velocities;
+
+pub use blocks::block_error;
+pub use thermo::{Sample, Thermo, Totals};
 
 use crate::engine::{Outcome, Simulation};
 use serde::{Deserialize, Serialize};
@@ -29,169 +36,80 @@ pub trait Observer<const D: usize> {
     fn observe(&mut self, sim: &Simulation<D>, outcome: &Outcome<D>);
 }
 
-/// Sums over an interval of time.
+/// The observables a configuration asks for: `[observe.<name>]`, one table each, holding its
+/// options (an empty table for the defaults). Unknown names are refused like any unknown
+/// key.
 #[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
-pub struct Totals {
-    /// Pair collisions.
-    pub pair_collisions: u64,
-    /// Wall collisions.
-    pub wall_collisions: u64,
-    /// Σ σ|Δp| over pair collisions.
-    pub virial: f64,
-    /// Impulse received by each wall: `[axis][0 = lower, 1 = upper]`.
-    pub wall_impulse: Vec<[f64; 2]>,
+#[serde(deny_unknown_fields)]
+pub struct Selection {
+    /// The velocity distribution at the start and at every sample ([`velocities`]).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub velocities: Option<velocities::Options>,
 }
 
-/// One row of the time series: an interval between sampling events.
+impl Selection {
+    /// Whether nothing is asked for.
+    pub fn is_empty(&self) -> bool {
+        *self == Selection::default()
+    }
+
+    /// The observables asked for, observing `sim` from now, in registry order.
+    pub fn start<const D: usize>(&self, sim: &Simulation<D>) -> Vec<Observable> {
+        let mut out = Vec::new();
+        if let Some(options) = &self.velocities {
+            out.push(Observable::Velocities(velocities::Velocities::new(sim, options.clone())));
+        }
+        out
+    }
+
+    /// The names asked for, in registry order (what [`start`](Self::start) builds).
+    pub fn names(&self) -> Vec<&'static str> {
+        let mut out = Vec::new();
+        if self.velocities.is_some() {
+            out.push("velocities");
+        }
+        out
+    }
+}
+
+/// A registered observable, as a run carries it (and saves it in its checkpoints).
+#[non_exhaustive]
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
-pub struct Sample {
-    /// Time at the end of the interval.
-    pub t: f64,
-    /// Kinetic energy at `t`.
-    pub kinetic_energy: f64,
-    /// kT at `t`.
-    pub kt: f64,
-    /// Pair collisions since the start of the production run.
-    pub collisions: u64,
-    /// Collision-virial pressure over the interval.
-    pub pressure_virial: f64,
-    /// Wall pressures over the interval: `[axis]` → `[lower, upper]`, `None` along periodic
-    /// axes (empty without walls).
-    pub pressure_walls: Vec<Option<[f64; 2]>>,
+#[serde(rename_all = "snake_case")]
+pub enum Observable {
+    /// The velocity distribution.
+    Velocities(velocities::Velocities),
 }
 
-/// The thermodynamic observer: totals since the start, the current interval, and the samples.
-#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
-pub struct Thermo {
-    /// Dimension.
-    pub dimension: usize,
-    /// Number-averaged diameter σ̄ (for accessible lengths).
-    pub mean_diameter: f64,
-    /// When the observation started.
-    pub start_time: f64,
-    /// Kinetic energy when it started.
-    pub start_kinetic_energy: f64,
-    /// Totals since the start.
-    pub total: Totals,
-    /// Totals since the last sample.
-    pub interval: Totals,
-    /// Start of the current interval.
-    pub interval_start: f64,
-    /// The time series so far.
-    pub samples: Vec<Sample>,
-}
-
-impl Thermo {
-    /// Starts observing `sim` now.
-    pub fn new<const D: usize>(sim: &Simulation<D>) -> Self {
-        let n = sim.particles().len() as f64;
-        let mean_diameter = sim.particles().iter().map(|p| 2.0 * p.radius).sum::<f64>() / n;
-        let empty = Totals { wall_impulse: vec![[0.0; 2]; D], ..Totals::default() };
-        Thermo {
-            dimension: D,
-            mean_diameter,
-            start_time: sim.time(),
-            start_kinetic_energy: sim.kinetic_energy(),
-            total: empty.clone(),
-            interval: empty,
-            interval_start: sim.time(),
-            samples: Vec::new(),
+impl Observable {
+    /// Its name (its key under `[observe]` and in the summary).
+    pub fn name(&self) -> &'static str {
+        match self {
+            Observable::Velocities(_) => "velocities",
         }
     }
 
-    /// Collision-virial pressure for totals `w` over `dt` at temperature `kt`.
-    pub fn virial_pressure<const D: usize>(&self, sim: &Simulation<D>, w: &Totals, dt: f64, kt: f64) -> f64 {
-        let n = sim.particles().len() as f64;
-        (n * kt + w.virial / (D as f64 * dt)) / sim.sim_box().accessible_volume(self.mean_diameter)
+    /// What it measured, for `summary.json`.
+    pub fn results(&self) -> serde_json::Value {
+        match self {
+            Observable::Velocities(v) => serde_json::to_value(v),
+        }
+        .expect("results serialise")
     }
 
-    /// Wall pressures for totals `w` over `dt`: `[axis]` → `[lower, upper]`, `None` along
-    /// periodic axes.
-    pub fn wall_pressures<const D: usize>(&self, sim: &Simulation<D>, w: &Totals, dt: f64) -> Vec<Option<[f64; 2]>> {
-        let b = sim.sim_box();
-        (0..D)
-            .map(|a| {
-                if b.boundary[a] != crate::engine::Boundary::Wall {
-                    return None;
-                }
-                let area: f64 =
-                    (0..D).filter(|&c| c != a).map(|c| b.accessible_length(c, self.mean_diameter)).product();
-                Some([w.wall_impulse[a][0] / (dt * area), w.wall_impulse[a][1] / (dt * area)])
-            })
-            .collect()
+    /// Whether it was built for `D` dimensions (a saved one must have been).
+    pub fn dimension(&self) -> usize {
+        match self {
+            Observable::Velocities(v) => v.dimension,
+        }
     }
 }
 
-impl<const D: usize> Observer<D> for Thermo {
+impl<const D: usize> Observer<D> for Observable {
+    #[inline]
     fn observe(&mut self, sim: &Simulation<D>, outcome: &Outcome<D>) {
-        match outcome {
-            Outcome::Pair { impulse, .. } => {
-                let v = impulse.virial();
-                for t in [&mut self.total, &mut self.interval] {
-                    t.pair_collisions += 1;
-                    t.virial += v;
-                }
-            }
-            Outcome::Wall { axis, upper, impulse, .. } => {
-                for t in [&mut self.total, &mut self.interval] {
-                    t.wall_collisions += 1;
-                    t.wall_impulse[*axis][usize::from(*upper)] += impulse;
-                }
-            }
-            Outcome::Sample => {
-                let now = sim.time();
-                let dt = now - self.interval_start;
-                let kt = sim.kt();
-                let pressure_virial = self.virial_pressure(sim, &self.interval, dt, kt);
-                let pressure_walls = if sim.sim_box().boundary.contains(&crate::engine::Boundary::Wall) {
-                    self.wall_pressures(sim, &self.interval, dt)
-                } else {
-                    Vec::new()
-                };
-                self.samples.push(Sample {
-                    t: now,
-                    kinetic_energy: sim.kinetic_energy(),
-                    kt,
-                    collisions: self.total.pair_collisions,
-                    pressure_virial,
-                    pressure_walls,
-                });
-                self.interval = Totals { wall_impulse: vec![[0.0; 2]; D], ..Totals::default() };
-                self.interval_start = now;
-            }
-            Outcome::Rebuild { .. } => {}
+        match self {
+            Observable::Velocities(v) => v.observe(sim, outcome),
         }
-    }
-}
-
-/// Mean and standard error of `values` from `blocks` consecutive blocks of equal length
-/// (the first `len % blocks` values are dropped). The standard error of the block means,
-/// `s/√B`, is honest when a block is longer than the correlation time of the series;
-/// returns NaN for the error with fewer than two blocks.
-pub fn block_error(values: &[f64], blocks: usize) -> (f64, f64) {
-    let blocks = blocks.min(values.len());
-    if blocks < 2 {
-        let mean = values.iter().sum::<f64>() / values.len().max(1) as f64;
-        return (mean, f64::NAN);
-    }
-    let size = values.len() / blocks;
-    let used = &values[values.len() - size * blocks..];
-    let means: Vec<f64> = used.chunks(size).map(|c| c.iter().sum::<f64>() / size as f64).collect();
-    let mean = means.iter().sum::<f64>() / blocks as f64;
-    let var = means.iter().map(|m| (m - mean).powi(2)).sum::<f64>() / (blocks - 1) as f64;
-    (mean, (var / blocks as f64).sqrt())
-}
-
-#[cfg(test)]
-mod tests {
-    use super::block_error;
-
-    #[test]
-    fn block_error_of_known_series() {
-        // Blocks of two: means 1.5, 3.5, 5.5, 7.5 → mean 4.5, sd 2.582, error 1.291.
-        let (m, e) = block_error(&[1.0, 2.0, 3.0, 4.0, 5.0, 6.0, 7.0, 8.0], 4);
-        assert_eq!(m, 4.5);
-        assert!((e - (20.0f64 / 3.0).sqrt() / 2.0).abs() < 1e-12, "{e}");
-        assert!(block_error(&[1.0], 4).1.is_nan());
     }
 }

@@ -6,7 +6,8 @@
 //! { "collide_version": "0.1.0",
 //!   "digest": "sha256:<64 hex digits>",
 //!   "run": { "config": …, "phase": "production", "state": …, "thermo": …,
-//!            "equilibration": …, "start_counts": …, "wall_time_s": …, "trajectory_bytes": … } }
+//!            ["observables": […],] "equilibration": …, "start_counts": …,
+//!            "wall_time_s": …, "trajectory_bytes": … } }
 //! ```
 //!
 //! The digest is the SHA-256 of the version, a NUL byte, and the compact JSON of `run` as
@@ -19,11 +20,11 @@
 //! A checkpoint that passes is then validated exactly like a fresh start, and its state
 //! against its own configuration ([`Run::resume`](super::Run::resume)).
 
-use super::{Equilibration, Phase};
-use crate::engine::{EventCounts, SimulationState};
-use crate::io::config::Config;
-use crate::io::text::shorten;
-use crate::observe::Thermo;
+use super::config::Config;
+use super::{Equilibration, Phase, RunError};
+use crate::engine::{EventCounts, SetupError, SimulationState};
+use crate::observe::{Observable, Thermo};
+use crate::text::shorten;
 use serde::{Deserialize, Serialize};
 use sha2::{Digest, Sha256};
 use std::fmt;
@@ -32,15 +33,18 @@ use std::path::Path;
 /// A run's complete state, as saved.
 #[derive(Clone, Debug, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
-pub struct Saved {
+pub struct Saved<const D: usize> {
     /// The configuration.
     pub config: Config,
     /// The phase the run is in.
     pub phase: Phase,
     /// The simulation.
-    pub state: SimulationState<2>,
-    /// The observer (of production; empty during equilibration).
+    pub state: SimulationState<D>,
+    /// The thermodynamics (of production; empty during equilibration).
     pub thermo: Thermo,
+    /// The observables the configuration names (of production), in registry order.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub observables: Vec<Observable>,
     /// The equilibration that preceded production (zero until it is over).
     pub equilibration: Equilibration,
     /// Event counts when production started.
@@ -54,13 +58,13 @@ pub struct Saved {
 /// A checkpoint: the state, the version that wrote it, and their digest.
 #[derive(Clone, Debug, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
-pub struct Checkpoint {
+pub struct Checkpoint<const D: usize> {
     /// The version that wrote it.
     pub collide_version: String,
     /// `"sha256:"` and the digest of the version and `run` (see the module docs).
     pub digest: String,
     /// The state.
-    pub run: Saved,
+    pub run: Saved<D>,
 }
 
 /// Why a checkpoint cannot be used.
@@ -79,9 +83,29 @@ pub enum CheckpointError {
     /// The content does not match the digest.
     Digest,
     /// The configuration it carries is invalid, or the run it describes out of reach.
-    Config(String),
+    Config(Box<RunError>),
     /// The state does not agree with the configuration, or is not a state a run reaches.
-    State(String),
+    State(StateError),
+    /// The saved simulation cannot be restored (overlaps, events that are not what its
+    /// state predicts, particles outside their cells).
+    Setup(SetupError),
+}
+
+/// A part of a saved run that does not agree with its configuration or with the rest.
+#[derive(Clone, Debug, PartialEq)]
+pub struct StateError {
+    /// Where in the checkpoint (`run.state.particles`).
+    pub field: &'static str,
+    /// What it holds.
+    pub found: String,
+    /// What it must hold.
+    pub expected: String,
+}
+
+impl fmt::Display for StateError {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        write!(f, "{}, {}", self.found, self.expected)
+    }
 }
 
 impl fmt::Display for CheckpointError {
@@ -101,6 +125,7 @@ impl fmt::Display for CheckpointError {
             ),
             CheckpointError::Config(e) => write!(f, "the configuration it carries: {e}"),
             CheckpointError::State(e) => write!(f, "its state does not fit its configuration: {e}"),
+            CheckpointError::Setup(e) => write!(f, "its state does not fit its configuration: {e}"),
         }
     }
 }
@@ -122,7 +147,7 @@ impl std::io::Write for Hashing {
 }
 
 /// The digest of a version and a saved state.
-fn digest(version: &str, run: &Saved) -> String {
+fn digest<const D: usize>(version: &str, run: &Saved<D>) -> String {
     let mut hash = Hashing(Sha256::new());
     hash.0.update(version.as_bytes());
     hash.0.update([0u8]);
@@ -136,9 +161,9 @@ fn digest(version: &str, run: &Saved) -> String {
     hex
 }
 
-impl Checkpoint {
+impl<const D: usize> Checkpoint<D> {
     /// Seals a saved state with this version and its digest.
-    pub fn seal(run: Saved) -> Checkpoint {
+    pub fn seal(run: Saved<D>) -> Checkpoint<D> {
         let collide_version = env!("CARGO_PKG_VERSION").to_string();
         Checkpoint { digest: digest(&collide_version, &run), collide_version, run }
     }
@@ -165,14 +190,14 @@ impl Checkpoint {
     }
 
     /// Reads and verifies a checkpoint file.
-    pub fn load(path: &Path) -> Result<Checkpoint, CheckpointError> {
+    pub fn load(path: &Path) -> Result<Checkpoint<D>, CheckpointError> {
         let bytes = std::fs::read(path).map_err(|e| CheckpointError::Read(e.to_string()))?;
         Checkpoint::from_json(&bytes)
     }
 
     /// Parses and verifies the text of a checkpoint.
-    pub fn from_json(bytes: &[u8]) -> Result<Checkpoint, CheckpointError> {
-        let checkpoint: Checkpoint =
+    pub fn from_json(bytes: &[u8]) -> Result<Checkpoint<D>, CheckpointError> {
+        let checkpoint: Checkpoint<D> =
             serde_json::from_slice(bytes).map_err(|e| CheckpointError::Format(shorten(&e.to_string())))?;
         checkpoint.verify()?;
         Ok(checkpoint)

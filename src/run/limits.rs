@@ -4,18 +4,19 @@
 //!
 //! # The estimate
 //!
-//! With `n = N/A`, the packing fraction `η`, the mean diameter `σ̄`, the mean mass `m̄` and
-//! Henderson's contact value `g = (1 − 7η/16)/(1 − η)²` (Mol. Phys. 30, 971 (1975)),
-//! Enskog's rate of collisions per particle is `Γ = 2nσ̄·g·√(πkT/m̄)` (2D), and a run of `C`
-//! pair collisions lasts about `T = 2C/(NΓ)`. It is a scheduling estimate — within a few
+//! With `n = N/V`, the packing fraction `η`, the mean diameter `σ̄`, the mean mass `m̄` and
+//! the contact value `g` of the dimension's equation of state (Henderson's in 2D,
+//! Carnahan–Starling's in 3D; [`crate::theory`]), Enskog's rate of collisions per particle
+//! is `Γ = 2nσ̄·g·√(πkT/m̄)` in 2D (`4nσ̄²·g·√(πkT/m̄)` in 3D), and a run of `C` pair
+//! collisions lasts about `T = 2C/(NΓ)`. It is a scheduling estimate — within a few
 //! per cent for a fluid, an overestimate of `T` near close packing where `g` grows faster —
 //! used only to refuse runs that are out of reach by orders of magnitude (10¹⁵⁰ collisions
 //! at `kT = 10³⁰⁰`, 10¹¹ samples at `sample_interval = 10⁻⁹`).
 
-use crate::engine::simulation::MAX_PARTICLES;
-use crate::io::config::Config;
-use crate::io::text::num;
-use crate::theory::{enskog_rate_2d, g_henderson};
+use super::config::Config;
+use crate::engine::MAX_PARTICLES;
+use crate::text::num;
+use crate::theory::{contact_value, enskog_rate};
 use std::fmt;
 
 /// Tunables of the limits and the watchdog, with automatic defaults
@@ -189,8 +190,9 @@ impl fmt::Display for LimitError {
 
 impl std::error::Error for LimitError {}
 
-/// Checks `config` (already valid) in a box of area `area` against `limits`.
-pub fn check(config: &Config, area: f64, limits: &Limits) -> Result<Estimate, LimitError> {
+/// Checks `config` (already valid) in a box of volume `volume` (an area in 2D) against
+/// `limits`.
+pub fn check<const D: usize>(config: &Config, volume: f64, limits: &Limits) -> Result<Estimate, LimitError> {
     let n = config.n_particles();
     if n > limits.max_particles {
         return Err(LimitError::TooManyParticles { n, max: limits.max_particles });
@@ -198,9 +200,10 @@ pub fn check(config: &Config, area: f64, limits: &Limits) -> Result<Estimate, Li
     let nf = n as f64;
     let sigma = config.species.iter().map(|s| s.count as f64 * 2.0 * s.radius).sum::<f64>() / nf;
     let mass = config.species.iter().map(|s| s.count as f64 * s.mass).sum::<f64>() / nf;
-    let eta = crate::engine::init::disk_area(&config.species) / area;
-    // Henderson's contact value is only a rough guide near close packing: capped there.
-    let rate = enskog_rate_2d(nf / area, sigma, g_henderson(eta.min(0.9)), config.init.kt, mass);
+    let eta = crate::engine::init::particle_volume::<D>(&config.species) / volume;
+    // The contact values are only a rough guide near close packing: capped there.
+    let cap = if D == 2 { 0.9 } else { 0.7 };
+    let rate = enskog_rate(D, nf / volume, sigma, contact_value(D, eta.min(cap)), config.init.kt, mass);
     let collisions_in = |t: f64| 0.5 * nf * rate * t;
     let time_for = |c: f64| 2.0 * c / (nf * rate);
     let too_many = |field, value: f64, collisions: f64| {

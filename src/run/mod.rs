@@ -1,25 +1,35 @@
 //! A run: configuration → limits → initial state → equilibration → production with
-//! observers → summary. No files here (see [`crate::io::output`]); a [`Checkpoint`] holds
-//! everything needed to continue bit-identically.
+//! observers → summary, in `D` dimensions. [`Run`] owns the one loop of both phases
+//! ([`Run::advance`]): after every event it feeds the run's own observers (in production)
+//! and a [`Sink`] given by the caller — the files of `collide run`, an experiment's own
+//! observers — stops at the next event when asked (a signal), and stops a run that no longer
+//! advances ([`watchdog`]). A [`Checkpoint`] holds everything needed to continue
+//! bit-identically; the [`Summary`] is what the run measured.
 //!
-//! [`Run::advance`] owns the loop of both phases: it feeds each event's [`Outcome`] to a
-//! [`Sink`] (the files of `collide run`), stops at the next event when asked (a signal),
-//! and stops a run that no longer advances ([`watchdog`]). It returns how the run ended
-//! ([`Status`]), which the summary carries.
+//! * [`config`]: the TOML configuration and its validation;
+//! * [`limits`], [`watchdog`]: what a run may cost, and the stop for one that is stuck;
+//! * [`checkpoint`]: the saved state, sealed by a digest;
+//! * [`summary`]: estimates, error bars, status;
+//! * [`output`], [`rundir`]: the files of `collide run` and the directory that holds them.
 
 pub mod checkpoint;
+pub mod config;
 pub mod limits;
+pub mod output;
+pub mod rundir;
+pub mod summary;
 pub mod watchdog;
 
-pub use checkpoint::{Checkpoint, CheckpointError, Saved};
+pub use checkpoint::{Checkpoint, CheckpointError, Saved, StateError};
+pub use config::{Config, ConfigError, Invalid};
 pub use limits::{Estimate, LimitError, Limits};
+pub use summary::{Summary, WallPressure};
 pub use watchdog::Stall;
 
-use crate::engine::init::{InitError, Placement, box_for_packing_fraction, disk_area, initial_particles};
-use crate::engine::{EventCounts, Outcome, OverlapAudit, SetupError, SimBox, Simulation, check_box};
-use crate::io::config::Config;
-use crate::observe::{Observer, Thermo, block_error};
-use nalgebra::Vector2;
+use crate::engine::init::{InitError, Placement, box_for_packing_fraction, initial_particles, lattice_limit};
+use crate::engine::{EventCounts, Outcome, Particle, SetupError, SimBox, Simulation, check_box};
+use crate::observe::{Observable, Observer, Thermo};
+use nalgebra::SVector;
 use serde::{Deserialize, Serialize};
 use std::fmt;
 use std::sync::atomic::{AtomicBool, Ordering};
@@ -31,11 +41,25 @@ use watchdog::Watchdog;
 #[derive(Clone, Debug, PartialEq)]
 pub enum RunError {
     /// The configuration is invalid.
-    Config(String),
+    Config(Invalid),
+    /// The box the configuration describes cannot hold its particles.
+    Box {
+        /// Why not.
+        error: SetupError,
+        /// The keys the box comes from, and their values.
+        from: String,
+    },
     /// The run is out of reach (particles, memory, collisions, samples).
     Limit(LimitError),
     /// The initial state could not be built.
     Init(InitError),
+    /// A lattice of a mixture puts neighbours closer than the largest contact distance.
+    LatticeOverlap {
+        /// The overlap found.
+        error: SetupError,
+        /// The packing fraction up to which a triangular lattice holds these species.
+        fits_up_to: f64,
+    },
     /// The initial state is not a valid configuration (overlap, box too small, …).
     Setup(SetupError),
     /// A checkpoint that cannot be continued.
@@ -46,8 +70,13 @@ impl fmt::Display for RunError {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         match self {
             RunError::Config(e) => write!(f, "{e}"),
+            RunError::Box { error, from } => write!(f, "{error} ({from})"),
             RunError::Limit(e) => write!(f, "{e}"),
             RunError::Init(e) => write!(f, "initial state: {e}"),
+            RunError::LatticeOverlap { error, fits_up_to } => write!(
+                f,
+                "initial state: {error}: the lattice's sites are closer than the largest contact distance; a triangular lattice holds these species up to η ≈ {fits_up_to:.4}"
+            ),
             RunError::Setup(e) => write!(f, "initial state: {e}"),
             RunError::Checkpoint(e) => write!(f, "{e}"),
         }
@@ -102,35 +131,53 @@ impl Status {
     }
 }
 
-/// What a run does with each event besides observing it: `collide run` writes its files.
-pub trait Sink {
-    /// What can go wrong.
+/// What a run feeds each event besides its own observers, with the whole run in view: the
+/// files of `collide run` (trajectory frames, checkpoints), an experiment's observers.
+///
+/// Every [`Observer`] is a sink that sees the production events ([`Sink::event`] hands it
+/// the simulation and the outcome); a sink of its own sees both phases.
+pub trait Sink<const D: usize> {
+    /// What can go wrong (a sink's error stops the run, and [`Run::advance`] returns it).
     type Error;
     /// Called after every event of both phases, with the run as the event left it.
-    fn event(&mut self, run: &Run, outcome: &Outcome<2>) -> Result<(), Self::Error>;
+    fn event(&mut self, run: &Run<D>, outcome: &Outcome<D>) -> Result<(), Self::Error>;
     /// Called now and then with the phase and the fraction of it done.
     fn progress(&mut self, _phase: Phase, _done: f64) {}
+}
+
+impl<const D: usize, O: Observer<D>> Sink<D> for O {
+    type Error = std::convert::Infallible;
+    #[inline]
+    fn event(&mut self, run: &Run<D>, outcome: &Outcome<D>) -> Result<(), Self::Error> {
+        if run.phase.is_production() {
+            self.observe(&run.sim, outcome);
+        }
+        Ok(())
+    }
 }
 
 /// A sink that does nothing.
 pub struct Discard;
 
-impl Sink for Discard {
+impl<const D: usize> Sink<D> for Discard {
     type Error = std::convert::Infallible;
-    fn event(&mut self, _: &Run, _: &Outcome<2>) -> Result<(), Self::Error> {
+    #[inline]
+    fn event(&mut self, _: &Run<D>, _: &Outcome<D>) -> Result<(), Self::Error> {
         Ok(())
     }
 }
 
-/// A run in progress (2D).
+/// A run in progress.
 #[derive(Clone, Debug)]
-pub struct Run {
+pub struct Run<const D: usize> {
     /// The configuration.
     pub config: Config,
     /// The simulation.
-    pub sim: Simulation<2>,
-    /// The observer (replaced at the start of production).
+    pub sim: Simulation<D>,
+    /// The thermodynamics (started afresh when production starts).
     pub thermo: Thermo,
+    /// The observables the configuration names (started when production starts).
+    pub observables: Vec<Observable>,
     /// What the equilibration did.
     pub equilibration: Equilibration,
     /// What the run may cost, and the watchdog's tunables.
@@ -148,11 +195,11 @@ pub struct Run {
     ended: (Status, Option<Stall>),
 }
 
-/// The box a configuration describes.
-pub fn box_of(config: &Config) -> SimBox<2> {
-    let boundary = config.boundaries();
+/// The box a configuration (checked for `D`) describes.
+pub fn box_of<const D: usize>(config: &Config) -> SimBox<D> {
+    let boundary = config.boundaries::<D>();
     match (&config.sim_box.size, config.sim_box.packing_fraction) {
-        (Some(size), _) => SimBox { lengths: Vector2::new(size[0], size[1]), boundary },
+        (Some(size), _) => SimBox { lengths: SVector::from_fn(|a, _| size[a]), boundary },
         (None, Some(eta)) => {
             box_for_packing_fraction(&config.species, eta, boundary, config.init.placement, config.sim_box.aspect)
         }
@@ -162,55 +209,111 @@ pub fn box_of(config: &Config) -> SimBox<2> {
 
 /// Checks a configuration, its box and its limits: everything that can be said before any
 /// particle exists.
-fn admit(config: &Config, limits: &Limits) -> Result<(SimBox<2>, Estimate), RunError> {
-    config.check().map_err(RunError::Config)?;
-    let sim_box = box_of(config);
+fn admit<const D: usize>(config: &Config, limits: &Limits) -> Result<(SimBox<D>, Estimate), RunError> {
+    config.check_for(D).map_err(RunError::Config)?;
+    let sim_box = box_of::<D>(config);
     let reach = 2.0 * config.species.iter().map(|s| s.radius).fold(0.0, f64::max);
-    check_box(&sim_box, reach).map_err(|e| {
+    check_box(&sim_box, reach).map_err(|error| {
         let b = &config.sim_box;
         let from = match (b.packing_fraction, b.aspect) {
             (Some(eta), Some(aspect)) => {
-                format!(" (the box comes from box.packing_fraction = {eta} and box.aspect = {aspect})")
+                format!("the box comes from box.packing_fraction = {eta} and box.aspect = {aspect}")
             }
-            (Some(eta), None) => format!(" (the box comes from box.packing_fraction = {eta})"),
-            _ => " (box.size)".to_string(),
+            (Some(eta), None) => format!("the box comes from box.packing_fraction = {eta}"),
+            _ => "box.size".to_string(),
         };
-        RunError::Config(format!("{e}{from}"))
+        RunError::Box { error, from }
     })?;
-    let estimate = limits::check(config, sim_box.volume(), limits).map_err(RunError::Limit)?;
+    let estimate = limits::check::<D>(config, sim_box.volume(), limits).map_err(RunError::Limit)?;
     Ok((sim_box, estimate))
 }
 
-impl Run {
+/// Checks that `particles` are those `config`'s species ask for: as many of each species, with
+/// its radius and mass.
+fn check_particles<const D: usize>(config: &Config, particles: &[Particle<D>]) -> Result<(), StateError> {
+    let bad = |field: &'static str, found: String, expected: String| Err(StateError { field, found, expected });
+    let n = config.n_particles();
+    if particles.len() != n {
+        return bad(
+            "run.state.particles",
+            format!("{} particles", particles.len()),
+            format!("the species ask for {n}"),
+        );
+    }
+    let mut counts = vec![0usize; config.species.len()];
+    for (i, p) in particles.iter().enumerate() {
+        let Some(s) = config.species.get(p.species as usize) else {
+            return bad(
+                "run.state.particles.species",
+                format!("particle {i} is of species {}", p.species),
+                format!("there are {}", config.species.len()),
+            );
+        };
+        if p.radius != s.radius || p.mass != s.mass {
+            return bad(
+                "run.state.particles",
+                format!("particle {i} (species {}) has radius {} and mass {}", p.species, p.radius, p.mass),
+                format!("its species {} and {}", s.radius, s.mass),
+            );
+        }
+        counts[p.species as usize] += 1;
+    }
+    if let Some(k) = (0..counts.len()).find(|&k| counts[k] != config.species[k].count) {
+        return bad(
+            "run.state.particles",
+            format!("{} particles of species {k}", counts[k]),
+            format!("it asks for {}", config.species[k].count),
+        );
+    }
+    Ok(())
+}
+
+impl<const D: usize> Run<D> {
     /// Builds the initial state (not yet equilibrated), with the limits of this machine.
-    pub fn new(config: Config) -> Result<Run, RunError> {
+    pub fn new(config: Config) -> Result<Run<D>, RunError> {
         Run::with_limits(config, Limits::for_this_machine())
     }
 
     /// [`new`](Self::new) with the limits given.
-    pub fn with_limits(config: Config, limits: Limits) -> Result<Run, RunError> {
-        let (sim_box, estimate) = admit(&config, &limits)?;
+    pub fn with_limits(config: Config, limits: Limits) -> Result<Run<D>, RunError> {
+        let (sim_box, estimate) = admit::<D>(&config, &limits)?;
         let init = &config.init;
         let particles =
             initial_particles(&config.species, &sim_box, init.placement, init.velocities, init.kt, config.seed)
                 .map_err(RunError::Init)?;
-        let sim = Simulation::new(particles, sim_box).map_err(|e| match e {
+        let sim = Simulation::new(particles, sim_box).map_err(|error| match error {
             // On a lattice of a mixture, neighbours closer than the largest contact distance
             // can overlap: say so, and what would fit.
             SetupError::Overlap { .. } if config.init.placement != Placement::Random => {
-                let fits = crate::engine::init::lattice_limit(&config.species);
-                RunError::Config(format!(
-                    "initial state: {e}: the lattice's sites are closer than the largest contact distance; a triangular lattice holds these species up to η ≈ {fits:.4}"
-                ))
+                match lattice_limit::<D>(&config.species) {
+                    Some(fits_up_to) => RunError::LatticeOverlap { error, fits_up_to },
+                    None => RunError::Setup(error),
+                }
             }
-            e => RunError::Setup(e),
+            error => RunError::Setup(error),
         })?;
-        let thermo = Thermo::new(&sim);
-        Ok(Run {
+        Ok(Run::started(config, sim, limits, estimate))
+    }
+
+    /// A run of `config` from the given particles instead of its `[init]` (an experiment that
+    /// prepares a state of its own), with the limits of this machine: the particles must be
+    /// those of its species, inside its box, without overlaps.
+    pub fn from_particles(config: Config, particles: Vec<Particle<D>>) -> Result<Run<D>, RunError> {
+        let limits = Limits::for_this_machine();
+        let (sim_box, estimate) = admit::<D>(&config, &limits)?;
+        check_particles(&config, &particles).map_err(|e| RunError::Checkpoint(CheckpointError::State(e)))?;
+        let sim = Simulation::new(particles, sim_box).map_err(RunError::Setup)?;
+        Ok(Run::started(config, sim, limits, estimate))
+    }
+
+    /// A run about to equilibrate `sim`.
+    fn started(config: Config, sim: Simulation<D>, limits: Limits, estimate: Estimate) -> Run<D> {
+        Run {
             config,
             start_counts: sim.counts(),
+            thermo: Thermo::new(&sim),
             sim,
-            thermo,
+            observables: Vec::new(),
             equilibration: Equilibration::default(),
             limits,
             estimate,
@@ -218,11 +321,45 @@ impl Run {
             wall_before: 0.0,
             wall_since: None,
             ended: (Status::Complete, None),
-        })
+        }
+    }
+
+    /// Runs the equilibration alone (the same loop as [`advance`](Self::advance)), then
+    /// starts production, so that its length and sampling can be planned from what the
+    /// equilibration found ([`plan_production`](Self::plan_production)) before
+    /// [`advance`](Self::advance) runs it. Nothing stops it but the watchdog.
+    pub fn equilibrate<S: Sink<D>>(&mut self, sink: &mut S) -> Result<Status, S::Error> {
+        if self.phase == Phase::Equilibration {
+            if let Some(status) = self.drive(Phase::Equilibration, &AtomicBool::new(false), sink)? {
+                return Ok(status);
+            }
+            self.start_production();
+        }
+        Ok(Status::Complete)
+    }
+
+    /// Sets the production's length (collisions and/or time) and sampling interval, before
+    /// any production event: validated as the configuration's `[run]` would be.
+    pub fn plan_production(
+        &mut self,
+        collisions: Option<u64>,
+        time: Option<f64>,
+        sample_interval: f64,
+    ) -> Result<(), Invalid> {
+        let mut config = self.config.clone();
+        config.run.collisions = collisions;
+        config.run.time = time;
+        config.run.sample_interval = sample_interval;
+        config.check_for(D)?;
+        self.config = config;
+        if self.phase.is_production() {
+            self.sim.sample_every(sample_interval);
+        }
+        Ok(())
     }
 
     /// Continues from a checkpoint, with the limits of this machine.
-    pub fn resume(checkpoint: Checkpoint) -> Result<Run, RunError> {
+    pub fn resume(checkpoint: Checkpoint<D>) -> Result<Run<D>, RunError> {
         Run::resume_with_limits(checkpoint, Limits::for_this_machine())
     }
 
@@ -230,72 +367,88 @@ impl Run {
     /// ([`Checkpoint::verify`]), its configuration validated exactly like a fresh start,
     /// and its state checked against that configuration: the particles of every species
     /// with their radii and masses, the box, no overlap, the bookkeeping of the phase.
-    pub fn resume_with_limits(checkpoint: Checkpoint, limits: Limits) -> Result<Run, RunError> {
+    pub fn resume_with_limits(checkpoint: Checkpoint<D>, limits: Limits) -> Result<Run<D>, RunError> {
         checkpoint.verify().map_err(RunError::Checkpoint)?;
-        let Saved { config, phase, state, thermo, equilibration, start_counts, wall_time_s, trajectory_bytes: _ } =
-            checkpoint.run;
+        let Saved {
+            config,
+            phase,
+            state,
+            thermo,
+            observables,
+            equilibration,
+            start_counts,
+            wall_time_s,
+            trajectory_bytes: _,
+        } = checkpoint.run;
         let (sim_box, estimate) =
-            admit(&config, &limits).map_err(|e| RunError::Checkpoint(CheckpointError::Config(e.to_string())))?;
-        let bad = |what: String| Err(RunError::Checkpoint(CheckpointError::State(what)));
-        let n = config.n_particles();
-        if state.particles.len() != n {
-            return bad(format!("{} particles, the species ask for {n}", state.particles.len()));
-        }
-        let mut counts = vec![0usize; config.species.len()];
-        for (i, p) in state.particles.iter().enumerate() {
-            let Some(s) = config.species.get(p.species as usize) else {
-                return bad(format!("particle {i} is of species {}, there are {}", p.species, config.species.len()));
-            };
-            if p.radius != s.radius || p.mass != s.mass {
-                return bad(format!(
-                    "particle {i} (species {}) has radius {} and mass {}, its species {} and {}",
-                    p.species, p.radius, p.mass, s.radius, s.mass
-                ));
-            }
-            counts[p.species as usize] += 1;
-        }
-        if let Some(k) = (0..counts.len()).find(|&k| counts[k] != config.species[k].count) {
-            return bad(format!("{} particles of species {k}, it asks for {}", counts[k], config.species[k].count));
+            admit::<D>(&config, &limits).map_err(|e| RunError::Checkpoint(CheckpointError::Config(Box::new(e))))?;
+        let bad = |field: &'static str, found: String, expected: String| {
+            Err(RunError::Checkpoint(CheckpointError::State(StateError { field, found, expected })))
+        };
+        if let Err(e) = check_particles(&config, &state.particles) {
+            return Err(RunError::Checkpoint(CheckpointError::State(e)));
         }
         let c = &state.counts;
-        let s = &start_counts;
-        if s.pair > c.pair || s.wall > c.wall || s.rebuild > c.rebuild || s.sample > c.sample || s.stale > c.stale {
-            return bad(format!("production started at event counts {s:?}, after the current {c:?}"));
+        if !c.at_least(&start_counts) {
+            return bad(
+                "run.start_counts",
+                format!("production started at event counts {start_counts:?}"),
+                format!("after the current {c:?}"),
+            );
         }
         let sampling = match phase {
             Phase::Equilibration => None,
             Phase::Production => Some(config.run.sample_interval),
         };
         if state.sampling != sampling {
-            return bad(format!(
-                "sampling every {:?} in {phase:?}, the configuration says {sampling:?}",
-                state.sampling
-            ));
+            return bad(
+                "run.state.sampling",
+                format!("sampling every {:?} in {phase:?}", state.sampling),
+                format!("the configuration says {sampling:?}"),
+            );
         }
-        if thermo.dimension != 2
-            || thermo.total.wall_impulse.len() != 2
-            || thermo.interval.wall_impulse.len() != 2
-            || thermo.samples.iter().any(|s| !matches!(s.pressure_walls.len(), 0 | 2))
+        let walls_per_sample = |w: usize| w == 0 || w == D;
+        if thermo.dimension != D
+            || thermo.total.wall_impulse.len() != D
+            || thermo.interval.wall_impulse.len() != D
+            || thermo.samples.iter().any(|s| !walls_per_sample(s.pressure_walls.len()))
         {
-            return bad("the observer is not of a 2D run".into());
+            return bad("run.thermo", format!("the observer is of a {}D run", thermo.dimension), format!("not {D}D"));
         }
         let observed = thermo.total.pair_collisions;
-        let production = if phase.is_production() { c.pair - s.pair } else { 0 };
+        let production = if phase.is_production() { c.pair - start_counts.pair } else { 0 };
         if observed != production {
-            return bad(format!("the observer saw {observed} pair collisions, the counts say {production}"));
+            return bad(
+                "run.thermo.total.pair_collisions",
+                format!("the observer saw {observed} pair collisions"),
+                format!("the counts say {production}"),
+            );
+        }
+        let names: Vec<&str> = observables.iter().map(Observable::name).collect();
+        let asked = if phase.is_production() { config.observe.names() } else { Vec::new() };
+        if names != asked || observables.iter().any(|o| o.dimension() != D) {
+            return bad(
+                "run.observables",
+                format!("observables {names:?}"),
+                format!("the configuration asks for {asked:?} in {D}D"),
+            );
         }
         if thermo.samples.len() > limits.max_samples {
-            return bad(format!("{} samples, more than a run keeps ({})", thermo.samples.len(), limits.max_samples));
+            return bad(
+                "run.thermo.samples",
+                format!("{} samples", thermo.samples.len()),
+                format!("more than a run keeps ({})", limits.max_samples),
+            );
         }
         if !(wall_time_s.is_finite() && wall_time_s >= 0.0) {
-            return bad(format!("wall_time_s = {wall_time_s}"));
+            return bad("run.wall_time_s", format!("wall_time_s = {wall_time_s}"), "a finite number ≥ 0".into());
         }
-        let sim = Simulation::restore(state, sim_box)
-            .map_err(|e| RunError::Checkpoint(CheckpointError::State(e.to_string())))?;
+        let sim = Simulation::restore(state, sim_box).map_err(|e| RunError::Checkpoint(CheckpointError::Setup(e)))?;
         Ok(Run {
             config,
             sim,
             thermo,
+            observables,
             equilibration,
             limits,
             estimate,
@@ -308,12 +461,13 @@ impl Run {
     }
 
     /// The state to save; `trajectory_bytes` is the length of the trajectory written so far.
-    pub fn checkpoint(&self, trajectory_bytes: u64) -> Checkpoint {
+    pub fn checkpoint(&self, trajectory_bytes: u64) -> Checkpoint<D> {
         Checkpoint::seal(Saved {
             config: self.config.clone(),
             phase: self.phase,
             state: self.sim.state(),
             thermo: self.thermo.clone(),
+            observables: self.observables.clone(),
             equilibration: self.equilibration,
             start_counts: self.start_counts,
             wall_time_s: self.wall_time(),
@@ -324,6 +478,16 @@ impl Run {
     /// The phase the run is in.
     pub fn phase(&self) -> Phase {
         self.phase
+    }
+
+    /// Event counts when production started (zero before).
+    pub fn start_counts(&self) -> EventCounts {
+        self.start_counts
+    }
+
+    /// How the last [`advance`](Self::advance) ended, and the watchdog's reason if stalled.
+    pub fn ended(&self) -> (Status, Option<&Stall>) {
+        (self.ended.0, self.ended.1.as_ref())
     }
 
     /// Whether both lengths of the equilibration are reached (an absent one counts as
@@ -341,37 +505,15 @@ impl Run {
         by_collisions.min(by_time).min(1.0)
     }
 
-    /// Starts production: the equilibration is recorded, the observer reset, sampling
-    /// scheduled.
+    /// Starts production: the equilibration is recorded, the observers started afresh,
+    /// sampling scheduled.
     fn start_production(&mut self) {
         self.equilibration = Equilibration { collisions: self.sim.counts().pair, time: self.sim.time() };
         self.thermo = Thermo::new(&self.sim);
+        self.observables = self.config.observe.start(&self.sim);
         self.start_counts = self.sim.counts();
         self.sim.sample_every(self.config.run.sample_interval);
         self.phase = Phase::Production;
-    }
-
-    /// Runs the equilibration (`progress` is called now and then with the fraction done),
-    /// then starts production: observers reset, sampling scheduled. For experiments that
-    /// drive production themselves with [`step`](Self::step). The watchdog watches it as it
-    /// watches [`advance`](Self::advance); a stall ends it, and the summary says so.
-    pub fn equilibrate(&mut self, progress: impl FnMut(f64)) {
-        struct Progress<F>(F);
-        impl<F: FnMut(f64)> Sink for Progress<F> {
-            type Error = std::convert::Infallible;
-            fn event(&mut self, _: &Run, _: &Outcome<2>) -> Result<(), Self::Error> {
-                Ok(())
-            }
-            fn progress(&mut self, _: Phase, done: f64) {
-                (self.0)(done);
-            }
-        }
-        if self.phase == Phase::Equilibration {
-            let never = AtomicBool::new(false);
-            // Nothing stops it but a stall, which records itself.
-            let Ok(_) = self.drive(Phase::Equilibration, &never, &mut Progress(progress));
-            self.start_production();
-        }
     }
 
     /// Production pair collisions so far.
@@ -403,14 +545,6 @@ impl Run {
             || run.time.is_some_and(|t| (self.sim.time() - self.thermo.start_time) / t >= 1.0)
     }
 
-    /// One event of the production run, observed; `None` when nothing can happen any more.
-    pub fn step(&mut self) -> Option<Outcome<2>> {
-        debug_assert!(self.phase.is_production(), "equilibrate() starts production");
-        let outcome = self.sim.step()?;
-        self.thermo.observe(&self.sim, &outcome);
-        Some(outcome)
-    }
-
     /// Production wall-clock seconds so far, over every process that ran it.
     pub fn wall_time(&self) -> f64 {
         self.wall_before + self.wall_since.map_or(0.0, |t| t.elapsed().as_secs_f64())
@@ -420,7 +554,7 @@ impl Run {
     /// how the run ended. It stops early, with the state intact, at the first event after
     /// `stop` is set ([`Status::Interrupted`]), when the watchdog finds the clock stuck
     /// ([`Status::Stalled`]), or when the run holds [`Limits::max_samples`] samples.
-    pub fn advance<S: Sink>(&mut self, stop: &AtomicBool, sink: &mut S) -> Result<Status, S::Error> {
+    pub fn advance<S: Sink<D>>(&mut self, stop: &AtomicBool, sink: &mut S) -> Result<Status, S::Error> {
         let status = self.advance_inner(stop, sink);
         if let Some(since) = self.wall_since.take() {
             self.wall_before += since.elapsed().as_secs_f64();
@@ -434,7 +568,13 @@ impl Run {
         status
     }
 
-    fn advance_inner<S: Sink>(&mut self, stop: &AtomicBool, sink: &mut S) -> Result<Status, S::Error> {
+    /// [`advance`](Self::advance) to the end, unstoppable but by the watchdog (for
+    /// experiments and tests).
+    pub fn complete<S: Sink<D>>(&mut self, sink: &mut S) -> Result<Status, S::Error> {
+        self.advance(&AtomicBool::new(false), sink)
+    }
+
+    fn advance_inner<S: Sink<D>>(&mut self, stop: &AtomicBool, sink: &mut S) -> Result<Status, S::Error> {
         if self.phase == Phase::Equilibration {
             if let Some(status) = self.drive(Phase::Equilibration, stop, sink)? {
                 return Ok(status);
@@ -448,10 +588,10 @@ impl Run {
     /// Runs one phase until it is over, or nothing can happen any more (`None`), or the
     /// run must stop (`Some`: interrupted, stalled, too many samples). Both phases take the
     /// same steps: the phase only says when it is over, how far it is, and whether the
-    /// observer sees the events (production).
-    fn drive<S: Sink>(&mut self, phase: Phase, stop: &AtomicBool, sink: &mut S) -> Result<Option<Status>, S::Error> {
+    /// observers see the events (production).
+    fn drive<S: Sink<D>>(&mut self, phase: Phase, stop: &AtomicBool, sink: &mut S) -> Result<Option<Status>, S::Error> {
         let production = phase.is_production();
-        let done = |run: &Run| if production { run.progress() } else { run.equilibration_done() };
+        let done = |run: &Run<D>| if production { run.progress() } else { run.equilibration_done() };
         let limits = self.limits;
         let mut dog = Watchdog::new(&limits, self.sim.time(), done(self), self.sim.counts());
         let mut events = 0u64;
@@ -462,7 +602,13 @@ impl Run {
             if production && self.thermo.samples.len() >= limits.max_samples {
                 return Ok(Some(Status::TooManySamples));
             }
-            let Some(outcome) = (if production { self.step() } else { self.sim.step() }) else { break };
+            let Some(outcome) = self.sim.step() else { break };
+            if production {
+                self.thermo.observe(&self.sim, &outcome);
+                for observable in &mut self.observables {
+                    observable.observe(&self.sim, &outcome);
+                }
+            }
             if dog.due()
                 && let Some(stall) = dog.look(&limits, self.sim.time(), done(self), self.sim.counts(), &outcome)
             {
@@ -477,177 +623,4 @@ impl Run {
         }
         Ok(None)
     }
-
-    /// The results so far (with production's wall-clock time over every process), marked
-    /// with how the last [`advance`](Self::advance) ended.
-    pub fn summary(&self) -> Summary {
-        let sim = &self.sim;
-        let n = sim.particles().len();
-        let production = self.phase.is_production();
-        let t = if production { sim.time() - self.thermo.start_time } else { 0.0 };
-        let kt = sim.kt();
-        let blocks = self.config.run.blocks;
-        let samples = &self.thermo.samples;
-        let pressure = self.thermo.virial_pressure(sim, &self.thermo.total, t, kt);
-        let (_, pressure_err) = block_error(&samples.iter().map(|s| s.pressure_virial).collect::<Vec<_>>(), blocks);
-        let density = n as f64 / sim.sim_box().accessible_volume(self.thermo.mean_diameter);
-        let walls = self.thermo.wall_pressures(sim, &self.thermo.total, t);
-        let mut wall_pressures = Vec::new();
-        for (axis, pair) in walls.iter().enumerate() {
-            let Some(pair) = pair else { continue };
-            for (side, name) in [(0, "lower"), (1, "upper")] {
-                let series: Vec<f64> = samples.iter().filter_map(|s| s.pressure_walls[axis].map(|w| w[side])).collect();
-                let (_, error) = block_error(&series, blocks);
-                wall_pressures.push(WallPressure { axis, side: name.into(), pressure: pair[side], error });
-            }
-        }
-        let counts = sim.counts();
-        let since = if production { counts.since(&self.start_counts) } else { EventCounts::default() };
-        let pair = self.thermo.total.pair_collisions;
-        let k0 = self.thermo.start_kinetic_energy;
-        let max_energy_deviation = samples.iter().map(|s| ((s.kinetic_energy - k0) / k0).abs()).fold(0.0, f64::max);
-        let audit = sim.check_overlaps();
-        let sim_box = sim.sim_box();
-        let wall_time_s = self.wall_time();
-        let mut warnings = Vec::new();
-        if production && samples.len() < 2 {
-            warnings.push(format!(
-                "{} sample(s): the error bars need at least 2 (use a smaller run.sample_interval or a longer run)",
-                samples.len()
-            ));
-        } else if production && samples.len() < blocks {
-            warnings.push(format!(
-                "{} samples for run.blocks = {blocks}: the error bars use {} blocks of one sample each",
-                samples.len(),
-                samples.len()
-            ));
-        }
-        if production && self.ended.0 == Status::Complete && !self.done() {
-            warnings
-                .push(format!("nothing can happen any more: the run ended at t = {} before its length", sim.time()));
-        }
-        Summary {
-            collide_version: env!("CARGO_PKG_VERSION").into(),
-            status: self.ended.0,
-            stall: self.ended.1.clone(),
-            phase: self.phase,
-            warnings,
-            n_particles: n,
-            packing_fraction: disk_area(&self.config.species) / sim_box.volume(),
-            seed: self.config.seed,
-            box_lengths: sim_box.lengths.iter().copied().collect(),
-            collisions: pair,
-            wall_collisions: self.thermo.total.wall_collisions,
-            events: since.total(),
-            events_by_kind: since,
-            sim_time: t,
-            wall_time_s,
-            collisions_per_second: pair as f64 / wall_time_s,
-            kT: kt,
-            pressure_virial: pressure,
-            pressure_virial_error: pressure_err,
-            compressibility: pressure / (density * kt),
-            compressibility_error: pressure_err / (density * kt),
-            wall_pressures,
-            collision_rate_per_particle: 2.0 * pair as f64 / (n as f64 * t),
-            energy_relative_drift: (sim.kinetic_energy() - k0) / k0,
-            max_energy_deviation,
-            max_overlap: audit,
-            samples: samples.len(),
-            equilibration: self.equilibration,
-            config: self.config.clone(),
-        }
-    }
-}
-
-/// One wall's pressure.
-#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
-pub struct WallPressure {
-    /// Axis normal to the wall.
-    pub axis: usize,
-    /// "lower" (at 0) or "upper" (at L).
-    pub side: String,
-    /// Impulse per time per accessible wall length.
-    pub pressure: f64,
-    /// Block-average standard error.
-    pub error: f64,
-}
-
-fn is_production(phase: &Phase) -> bool {
-    phase.is_production()
-}
-
-/// What `summary.json` holds (see the README for each field). `status`, `stall`, `phase`
-/// and `warnings` appear only when they say something: a run that completed its
-/// production without a warning has none of them.
-#[allow(non_snake_case)]
-#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
-pub struct Summary {
-    /// The version that wrote it.
-    pub collide_version: String,
-    /// How the run ended (absent: complete).
-    #[serde(default, skip_serializing_if = "Status::is_complete")]
-    pub status: Status,
-    /// Why the watchdog stopped it.
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub stall: Option<Stall>,
-    /// The phase it ended in (absent: production).
-    #[serde(default = "production", skip_serializing_if = "is_production")]
-    pub phase: Phase,
-    /// What the numbers below should be read with.
-    #[serde(default, skip_serializing_if = "Vec::is_empty")]
-    pub warnings: Vec<String>,
-    /// N.
-    pub n_particles: usize,
-    /// η = Σπ Rᵢ² / A.
-    pub packing_fraction: f64,
-    /// The seed.
-    pub seed: u64,
-    /// Box edge lengths.
-    pub box_lengths: Vec<f64>,
-    /// Production pair collisions.
-    pub collisions: u64,
-    /// Production wall collisions.
-    pub wall_collisions: u64,
-    /// Production events of every kind (stale ones excluded).
-    pub events: u64,
-    /// Production events by kind.
-    pub events_by_kind: EventCounts,
-    /// Production simulated time.
-    pub sim_time: f64,
-    /// Wall-clock time of the production run, seconds, over every process that ran it (with
-    /// `collisions_per_second`, the only non-reproducible fields).
-    pub wall_time_s: f64,
-    /// Pair collisions per wall-clock second.
-    pub collisions_per_second: f64,
-    /// kT = 2K/dof at the end.
-    pub kT: f64,
-    /// Collision-virial pressure.
-    pub pressure_virial: f64,
-    /// Its block-average standard error.
-    pub pressure_virial_error: f64,
-    /// Z = P/(n kT), n = N/A_acc.
-    pub compressibility: f64,
-    /// Its standard error.
-    pub compressibility_error: f64,
-    /// Per-wall pressures (empty without walls).
-    pub wall_pressures: Vec<WallPressure>,
-    /// Γ = 2·collisions/(N·t).
-    pub collision_rate_per_particle: f64,
-    /// (K_end − K_start)/K_start over production.
-    pub energy_relative_drift: f64,
-    /// Largest |K − K_start|/K_start over the samples.
-    pub max_energy_deviation: f64,
-    /// The overlap audit at the end.
-    pub max_overlap: OverlapAudit,
-    /// Samples (rows of timeseries.csv).
-    pub samples: usize,
-    /// The equilibration.
-    pub equilibration: Equilibration,
-    /// The configuration, echoed.
-    pub config: Config,
-}
-
-fn production() -> Phase {
-    Phase::Production
 }

@@ -85,13 +85,13 @@ impl Watchdog {
 
     /// Compares the clock and the fraction `done` with the last look; the stall, if any.
     #[cold]
-    pub fn look(
+    pub fn look<const D: usize>(
         &mut self,
         limits: &Limits,
         time: f64,
         done: f64,
         counts: EventCounts,
-        last: &Outcome<2>,
+        last: &Outcome<D>,
     ) -> Option<Stall> {
         let events = limits.watchdog_events.max(1);
         let gained = done - self.done;
@@ -103,25 +103,10 @@ impl Watchdog {
             by_kind: counts.since(&self.counts),
             done,
             projected,
-            last: describe(last),
+            last: last.to_string(),
         });
         *self = Watchdog { left: events, time, done, counts };
         stall
-    }
-}
-
-/// An event in words, naming its particles.
-pub fn describe(outcome: &Outcome<2>) -> String {
-    match outcome {
-        Outcome::Pair { i, j, .. } => format!("a collision of particles {i} and {j}"),
-        Outcome::Wall { i, axis, upper, .. } => {
-            format!(
-                "a collision of particle {i} with the {} wall of axis {axis}",
-                if *upper { "upper" } else { "lower" }
-            )
-        }
-        Outcome::Rebuild { i } => format!("a neighbourhood update of particle {i}"),
-        Outcome::Sample => "a sample".to_string(),
     }
 }
 
@@ -135,7 +120,7 @@ mod tests {
     }
 
     fn look(dog: &mut Watchdog, time: f64, done: f64) -> Option<Stall> {
-        let wall = Outcome::Wall { i: 3, axis: 0, upper: true, impulse: 0.0 };
+        let wall = Outcome::<2>::Wall { i: 3, axis: 0, upper: true, impulse: 0.0 };
         let mut stall = None;
         for _ in 0..4 {
             stall = if dog.due() { dog.look(&limits(), time, done, EventCounts::default(), &wall) } else { None };

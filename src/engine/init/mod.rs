@@ -1,13 +1,13 @@
-//! Initial states in 2D: where the disks start and how fast.
+//! Initial states in `D` dimensions: where the particles start and how fast.
 //!
-//! Placement ([`Placement`]): a triangular or square lattice whose shape follows the box
-//! (`lattice`; dense states, up to η ≈ 0.9 for the triangular lattice), or random
-//! sequential placement with rejection, largest disks first, in expected O(N) (`random`;
-//! dilute states and size-asymmetric mixtures). When a placement cannot work, the error
-//! says how far it got and what would.
+//! Placement ([`Placement`]): in 2D a triangular or square lattice whose shape follows the
+//! box (`lattice`; dense states, up to η ≈ 0.9 for the triangular lattice); in any dimension
+//! random sequential placement with rejection, largest particles first, in expected O(N)
+//! (`random`; dilute states and size-asymmetric mixtures). When a placement cannot work, the
+//! error says how far it got and what would.
 //!
 //! Velocities: Maxwell–Boltzmann (each component normal with variance kT/m), or one speed
-//! per species in uniformly random directions (`|v| = √(2kT/m)` in 2D, for relaxation
+//! per species in uniformly random directions (`|v| = √(D·kT/m)`, for relaxation
 //! experiments). Then the total momentum is removed along periodic axes, and all
 //! velocities are scaled so that `2K / dof` equals the target kT exactly (to rounding).
 //! Everything random comes from one seeded `Xoshiro256PlusPlus` (portable and
@@ -17,11 +17,12 @@ mod lattice;
 mod random;
 
 use super::geometry::{Boundary, Particle, SimBox};
+use crate::theory::RSA_JAMMING_2D;
 use nalgebra::{SVector, Vector2};
 use rand::rngs::Xoshiro256PlusPlus;
 use rand::seq::SliceRandom;
 use rand::{RngExt, SeedableRng};
-use rand_distr::{Distribution, Normal};
+use rand_distr::{Distribution, Normal, UnitSphere};
 use serde::{Deserialize, Serialize};
 use std::f64::consts::{PI, TAU};
 use std::fmt;
@@ -38,16 +39,27 @@ pub struct Species {
     pub mass: f64,
 }
 
-/// Where the disks start.
+/// Where the particles start.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
 #[serde(rename_all = "lowercase")]
 pub enum Placement {
-    /// Random sequential placement with rejection (dilute states).
+    /// Random sequential placement with rejection (dilute states; any dimension).
     Random,
-    /// Triangular lattice (vacancies chosen at random when N does not fill it).
+    /// Triangular lattice (vacancies chosen at random when N does not fill it; 2D).
     Triangular,
-    /// Square lattice.
+    /// Square lattice (2D).
     Square,
+}
+
+impl Placement {
+    /// Its name in a configuration.
+    pub fn name(self) -> &'static str {
+        match self {
+            Placement::Random => "random",
+            Placement::Triangular => "triangular",
+            Placement::Square => "square",
+        }
+    }
 }
 
 /// How the disks start moving.
@@ -56,7 +68,7 @@ pub enum Placement {
 pub enum Velocities {
     /// Maxwell–Boltzmann at kT.
     Maxwell,
-    /// One speed per species, √(2kT/m), random directions.
+    /// One speed per species, √(D·kT/m), random directions.
     FixedSpeed,
 }
 
@@ -78,9 +90,16 @@ pub enum InitError {
         reached: f64,
         /// The packing fraction asked for.
         requested_eta: f64,
-        /// The packing fraction up to which a triangular lattice holds these species with
-        /// its sites a largest diameter apart ([`lattice_limit`]).
-        lattice_fits_up_to: f64,
+        /// The packing fraction up to which a lattice of this dimension holds these species
+        /// with its sites a largest diameter apart ([`lattice_limit`]; none in 3D yet).
+        lattice_fits_up_to: Option<f64>,
+    },
+    /// A lattice placement asked for in a dimension it does not exist in.
+    NotInDimension {
+        /// The placement.
+        placement: Placement,
+        /// The dimension of the run.
+        dimension: usize,
     },
     /// Even the best lattice shape puts its sites closer than the smallest diameter.
     LatticeDoesNotFit {
@@ -126,23 +145,27 @@ impl fmt::Display for InitError {
             } => {
                 write!(
                     f,
-                    "random placement found no room for disk {} of {requested} (species {species}, radius {radius}) in {} tries, at packing fraction {reached:.4} of the {requested_eta:.4} asked for (random sequential placement jams near η ≈ {JAMMING} for equal disks, and gives up before): ",
+                    "random placement found no room for disk {} of {requested} (species {species}, radius {radius}) in {} tries, at packing fraction {reached:.4} of the {requested_eta:.4} asked for (random sequential placement jams near η ≈ {RSA_JAMMING_2D} for equal disks, and gives up before): ",
                     placed + 1,
                     random::TRIES
                 )?;
-                if lattice_fits_up_to >= requested_eta {
-                    write!(
+                match lattice_fits_up_to {
+                    Some(fits) if fits >= requested_eta => {
+                        write!(f, "use placement = \"triangular\", which holds these disks up to η ≈ {fits:.4}")
+                    }
+                    Some(fits) => write!(
                         f,
-                        "use placement = \"triangular\", which holds these disks up to η ≈ {lattice_fits_up_to:.4}"
-                    )
-                } else {
-                    write!(
-                        f,
-                        "no placement reaches it: a triangular lattice holds these disks up to η ≈ {lattice_fits_up_to:.4}, random placement got to {reached:.4}; start at or below {:.4}",
-                        lattice_fits_up_to.max(*reached)
-                    )
+                        "no placement reaches it: a triangular lattice holds these disks up to η ≈ {fits:.4}, random placement got to {reached:.4}; start at or below {:.4}",
+                        fits.max(*reached)
+                    ),
+                    None => write!(f, "random placement got to {reached:.4}; start at or below it"),
                 }
             }
+            InitError::NotInDimension { placement, dimension } => write!(
+                f,
+                "placement = \"{}\" is a 2D lattice; in {dimension}D use placement = \"random\"",
+                placement.name()
+            ),
             InitError::LatticeDoesNotFit { lattice, columns, rows, spacing, diameter, fits_up_to } => {
                 write!(
                     f,
@@ -169,56 +192,77 @@ impl fmt::Display for InitError {
 
 impl std::error::Error for InitError {}
 
-/// The random sequential adsorption (jamming) limit of equal disks, θ∞ ≈ 0.547
-/// (Hinrichsen, Feder & Jøssang, J. Stat. Phys. 44, 793 (1986)).
-const JAMMING: f64 = 0.547;
+/// The volume of a ball of radius `r` in `D` dimensions (an area in 2D): `πr²`, `4πr³/3`.
+pub fn ball_volume<const D: usize>(r: f64) -> f64 {
+    match D {
+        1 => 2.0 * r,
+        2 => PI * r * r,
+        3 => 4.0 / 3.0 * PI * r * r * r,
+        _ => unreachable!("particles live in 1 to 3 dimensions"),
+    }
+}
+
+/// The total volume of the particles (their area in 2D), `Σ N_s·V(R_s)`.
+pub fn particle_volume<const D: usize>(species: &[Species]) -> f64 {
+    species
+        .iter()
+        .map(|s| match D {
+            // Written out in 2D: the order of the products is that of every earlier release,
+            // so that boxes built from a packing fraction are the same to the bit.
+            2 => s.count as f64 * PI * s.radius * s.radius,
+            _ => s.count as f64 * ball_volume::<D>(s.radius),
+        })
+        .sum()
+}
 
 /// The packing fraction up to which a perfect triangular lattice of N sites holds these
-/// species with nearest sites one largest diameter apart: `Σπ Rᵢ² / (N·(√3/2)·σ_max²)`.
-pub fn lattice_limit(species: &[Species]) -> f64 {
+/// species with nearest sites one largest diameter apart: `Σπ Rᵢ² / (N·(√3/2)·σ_max²)` (2D;
+/// `None` in other dimensions, which have no lattice placement yet).
+pub fn lattice_limit<const D: usize>(species: &[Species]) -> Option<f64> {
+    if D != 2 {
+        return None;
+    }
     let n: f64 = species.iter().map(|s| s.count as f64).sum();
     let sigma = 2.0 * species.iter().map(|s| s.radius).fold(0.0, f64::max);
-    disk_area(species) / (n * 0.5 * 3f64.sqrt() * sigma * sigma)
+    Some(particle_volume::<2>(species) / (n * 0.5 * 3f64.sqrt() * sigma * sigma))
 }
 
-/// Total disk area Σ πRᵢ².
-pub fn disk_area(species: &[Species]) -> f64 {
-    species.iter().map(|s| s.count as f64 * PI * s.radius * s.radius).sum()
-}
-
-/// The box with packing fraction `eta` for these species, `aspect = Ly/Lx`. Without an
-/// aspect, a triangular lattice in a periodic box takes its own (so that it is perfect and
-/// wraps without defects), and every other start a square box.
-pub fn box_for_packing_fraction(
+/// The box with packing fraction `eta` for these species, `aspect = Ly/Lx` (the other edges
+/// equal to `Lx`). Without an aspect, a triangular lattice in a periodic box takes its own
+/// (so that it is perfect and wraps without defects), and every other start a cubic box.
+pub fn box_for_packing_fraction<const D: usize>(
     species: &[Species],
     eta: f64,
-    boundary: [Boundary; 2],
+    boundary: [Boundary; D],
     placement: Placement,
     aspect: Option<f64>,
-) -> SimBox<2> {
+) -> SimBox<D> {
     let n: usize = species.iter().map(|s| s.count).sum();
-    let area = disk_area(species) / eta;
+    let volume = particle_volume::<D>(species) / eta;
     let aspect = match aspect {
         Some(aspect) => aspect,
-        None if placement == Placement::Triangular && boundary == [Boundary::Periodic; 2] => {
+        None if D == 2 && placement == Placement::Triangular && boundary.iter().all(|&b| b == Boundary::Periodic) => {
             let (nx, ny) = lattice::triangular_shape(n, true);
             ny as f64 * 3f64.sqrt() / 2.0 / nx as f64
         }
         None => 1.0,
     };
-    let lx = (area / aspect).sqrt();
-    SimBox { lengths: Vector2::new(lx, lx * aspect), boundary }
+    let lx = match D {
+        2 => (volume / aspect).sqrt(),
+        _ => (volume / aspect).powf(1.0 / D as f64),
+    };
+    SimBox { lengths: SVector::from_fn(|a, _| if a == 1 { lx * aspect } else { lx }), boundary }
 }
 
 /// Builds the initial particles.
-pub fn initial_particles(
+pub fn initial_particles<const D: usize>(
     species: &[Species],
-    sim_box: &SimBox<2>,
+    sim_box: &SimBox<D>,
     placement: Placement,
     velocities: Velocities,
     kt: f64,
     seed: u64,
-) -> Result<Vec<Particle<2>>, InitError> {
+) -> Result<Vec<Particle<D>>, InitError> {
     let mut rng = Xoshiro256PlusPlus::seed_from_u64(seed);
     // Species of each particle, in a random order.
     let mut kinds: Vec<usize> = species.iter().enumerate().flat_map(|(k, s)| std::iter::repeat_n(k, s.count)).collect();
@@ -226,29 +270,36 @@ pub fn initial_particles(
     let n = kinds.len();
     let rmax = species.iter().map(|s| s.radius).fold(0.0, f64::max);
     let rmin = species.iter().map(|s| s.radius).fold(f64::INFINITY, f64::min);
-    for axis in 0..2 {
+    for axis in 0..D {
         let length = sim_box.lengths[axis];
         if !(length >= 2.0 * rmax) {
             return Err(InitError::BoxTooSmall { axis, length, diameter: 2.0 * rmax });
         }
     }
-    let positions = match placement {
+    let positions: Vec<SVector<f64, D>> = match placement {
         Placement::Random => random::positions(&kinds, species, sim_box, &mut rng)?,
+        Placement::Triangular | Placement::Square if D != 2 => {
+            return Err(InitError::NotInDimension { placement, dimension: D });
+        }
         Placement::Triangular | Placement::Square => {
             let kind =
                 if placement == Placement::Triangular { lattice::Kind::Triangular } else { lattice::Kind::Square };
-            let eta = disk_area(species) / sim_box.volume();
-            let mut sites = lattice::sites(kind, n, sim_box, rmax, rmin, eta)?;
+            let eta = particle_volume::<D>(species) / sim_box.volume();
+            let plane = SimBox {
+                lengths: Vector2::new(sim_box.lengths[0], sim_box.lengths[1]),
+                boundary: [sim_box.boundary[0], sim_box.boundary[1]],
+            };
+            let mut sites = lattice::sites(kind, n, &plane, rmax, rmin, eta)?;
             if sites.len() > n {
                 sites.shuffle(&mut rng);
                 sites.truncate(n);
                 // Keep a spatial order (row-major) for cache locality; vacancies stay random.
                 sites.sort_by(|a, b| a[1].total_cmp(&b[1]).then(a[0].total_cmp(&b[0])));
             }
-            sites
+            sites.into_iter().map(|x| SVector::from_fn(|a, _| x[a])).collect()
         }
     };
-    let mut particles: Vec<Particle<2>> = positions
+    let mut particles: Vec<Particle<D>> = positions
         .into_iter()
         .zip(&kinds)
         .map(|(position, &k)| Particle {
@@ -265,24 +316,41 @@ pub fn initial_particles(
         p.velocity = match velocities {
             Velocities::Maxwell => {
                 let normal = Normal::new(0.0, (kt / p.mass).sqrt()).map_err(|_| InitError::TooFewForTemperature)?;
-                Vector2::new(normal.sample(&mut rng), normal.sample(&mut rng))
+                // One draw per axis, in axis order.
+                SVector::from_fn(|_, _| normal.sample(&mut rng))
             }
-            Velocities::FixedSpeed => {
-                let theta: f64 = rng.random_range(0.0..TAU);
-                Vector2::new(theta.cos(), theta.sin()) * (2.0 * kt / p.mass).sqrt()
-            }
+            Velocities::FixedSpeed => direction::<D>(&mut rng) * (D as f64 * kt / p.mass).sqrt(),
         };
     }
     set_temperature(&mut particles, sim_box, kt)?;
     Ok(particles)
 }
 
+/// A uniformly random direction: an angle in 2D, a point of the unit sphere in 3D.
+fn direction<const D: usize>(rng: &mut Xoshiro256PlusPlus) -> SVector<f64, D> {
+    match D {
+        2 => {
+            let theta: f64 = rng.random_range(0.0..TAU);
+            SVector::from_fn(|a, _| if a == 0 { theta.cos() } else { theta.sin() })
+        }
+        3 => {
+            let x: [f64; 3] = UnitSphere.sample(rng);
+            SVector::from_fn(|a, _| x[a])
+        }
+        _ => SVector::from_fn(|_, _| if rng.random_bool(0.5) { 1.0 } else { -1.0 }),
+    }
+}
+
 /// Removes the total momentum along periodic axes, then scales every velocity so that
-/// `2K/dof = kt` (dof = 2N less one per periodic axis).
-pub fn set_temperature(particles: &mut [Particle<2>], sim_box: &SimBox<2>, kt: f64) -> Result<(), InitError> {
+/// `2K/dof = kt` (dof = D·N less one per periodic axis).
+pub fn set_temperature<const D: usize>(
+    particles: &mut [Particle<D>],
+    sim_box: &SimBox<D>,
+    kt: f64,
+) -> Result<(), InitError> {
     let total_mass: f64 = particles.iter().map(|p| p.mass).sum();
-    let momentum: SVector<f64, 2> = particles.iter().map(|p| p.velocity * p.mass).sum();
-    for a in 0..2 {
+    let momentum: SVector<f64, D> = particles.iter().map(|p| p.velocity * p.mass).sum();
+    for a in 0..D {
         if sim_box.boundary[a] == Boundary::Periodic {
             let drift = momentum[a] / total_mass;
             for p in particles.iter_mut() {
@@ -290,7 +358,7 @@ pub fn set_temperature(particles: &mut [Particle<2>], sim_box: &SimBox<2>, kt: f
             }
         }
     }
-    let dof = (2 * particles.len()).saturating_sub(sim_box.periodic_axes()) as f64;
+    let dof = (D * particles.len()).saturating_sub(sim_box.periodic_axes()) as f64;
     let kinetic: f64 = particles.iter().map(Particle::kinetic_energy).sum();
     if dof <= 0.0 || !(kinetic > 0.0 && kinetic.is_finite()) {
         return Err(InitError::TooFewForTemperature);

@@ -1,4 +1,4 @@
-//! The calendar: one [`Pending`] event per particle, threaded through buckets of time.
+//! The calendar: one [`Event`] event per particle, threaded through buckets of time.
 //!
 //! The slots are threaded through a *calendar* (Brown 1988; as used for event-driven dynamics by Paul, J. Comput.
 //! Phys. 221, 615 (2007), and Smallenburg 2022): time is cut into buckets of width `w`, an
@@ -6,19 +6,17 @@
 //! singly linked list `k mod B` (`B` a power of two, so a list also holds the rare events a
 //! multiple of `B·w` later, which the search skips). Replacing an event unlinks it from its
 //! list (a walk of about two entries) and links the new one in front: a few dozen
-//! instructions, where the [tournament tree](super::tree) walks ⌈log₄ N⌉ levels to the root
-//! — about 320 instructions per update at N = 10⁴, 770 per collision (callgrind).
+//! instructions, where the [tournament tree](super::tree) walks ⌈log₄ N⌉ levels to the root.
 //!
 //! The earliest event is found in the first bucket, from a cursor `current`, that holds an
 //! event of its own index: bucket indices are a monotone function of time (a product and a
 //! truncation, both monotone), so every event there comes no later than any event of a later
 //! bucket, and events at equal times share a bucket. Within it the engine's total order
-//! decides ([`Pending::before`]: by time, then by kind, then by particles and axes), exactly
+//! decides ([`Event::before`]: by time, then by kind, then by particles and axes), exactly
 //! as everywhere else, so the earliest event never depends on how it was reached — nor on
 //! `w`, which only sets how many events a bucket holds. `w` is chosen from the pending events
 //! (about one per bucket at the front of the calendar: searches then visit about four list
-//! entries and empty buckets; a width of ½, 1, 2 and 4 times this measured 5 467, 5 463,
-//! 5 509 and 5 626 instructions per collision at N = 10⁴, η = 0.65) when the queue is built,
+//! entries and empty buckets; widths from half to four times this cost about the same) when the queue is built,
 //! again every `4N` searches, and as soon as the searches grow long; an event earlier than the cursor (a prediction made from a clock
 //! behind the last event, after a re-prediction marker) moves the cursor back; after a whole
 //! round of `B` empty buckets the cursor jumps to the earliest bucket directly.
@@ -27,9 +25,9 @@
 //! Memory: 16 bytes per slot, 4 per link and 4 per bucket (`B` = N rounded up to a power of
 //! two): 24–28 bytes per particle.
 
+use super::Reads;
 use super::Slot;
-use crate::engine::events::Pending;
-use crate::engine::prefetch::prefetch;
+use crate::engine::sources::{Event, MAX_PARTICLES};
 
 /// End of a bucket list.
 const NONE: u32 = u32::MAX;
@@ -65,9 +63,8 @@ pub struct Calendar {
 }
 
 impl Calendar {
-    /// A queue over `pending` (one event per particle, at most
-    /// [`MAX_PARTICLES`](crate::engine::simulation::MAX_PARTICLES)).
-    pub fn new(pending: Vec<Pending>) -> Self {
+    /// A queue over `pending` (one event per particle, at most [`MAX_PARTICLES`]).
+    pub fn new(pending: Vec<Event>) -> Self {
         let mut queue = Calendar::nothing(pending.len());
         for (p, e) in pending.into_iter().enumerate() {
             queue.slots[p] = Slot::pack(e);
@@ -78,10 +75,10 @@ impl Calendar {
 
     /// A queue of `n` particles with nothing pending.
     pub fn nothing(n: usize) -> Self {
-        assert!((1..=crate::engine::simulation::MAX_PARTICLES).contains(&n), "1 ≤ n ≤ 2³² − 5 particles");
+        assert!((1..=MAX_PARTICLES).contains(&n), "1 ≤ n ≤ 2³² − 5 particles");
         let buckets = n.next_power_of_two();
         Calendar {
-            slots: vec![Slot::pack(Pending::NOTHING); n],
+            slots: vec![Slot::pack(Event::NOTHING); n],
             next: vec![NONE; n],
             heads: vec![NONE; buckets],
             mask: buckets as u64 - 1,
@@ -162,13 +159,13 @@ impl Calendar {
     }
 
     /// The pending events, by owner.
-    pub fn pending(&self) -> Vec<Pending> {
+    pub fn pending(&self) -> Vec<Event> {
         self.slots.iter().map(|s| s.unpack()).collect()
     }
 
     /// Particle `owner`'s pending event.
     #[inline]
-    pub fn get(&self, owner: usize) -> Pending {
+    pub fn get(&self, owner: usize) -> Event {
         self.slots[owner].unpack()
     }
 
@@ -216,7 +213,7 @@ impl Calendar {
     /// empty buckets each on average (a width chosen for other events: at the start, or
     /// after the temperature changed).
     #[inline]
-    pub fn first(&mut self) -> (usize, Pending) {
+    pub fn first(&mut self) -> (usize, Event) {
         self.searches += 1;
         if self.searches > 4 * self.slots.len()
             || (self.searches.is_multiple_of(CHECK_EVERY) && self.work > MOST_WORK * CHECK_EVERY)
@@ -246,7 +243,7 @@ impl Calendar {
 
     /// [`first`](Self::first) when every event is at `+∞`: the earliest by the total order.
     #[cold]
-    fn first_at_infinity(&self) -> (usize, Pending) {
+    fn first_at_infinity(&self) -> (usize, Event) {
         let mut best = 0u32;
         for p in 1..self.slots.len() as u32 {
             if self.before(p, best) {
@@ -258,7 +255,7 @@ impl Calendar {
 
     /// Replaces particle `owner`'s pending event.
     #[inline]
-    pub fn set(&mut self, owner: usize, event: Pending) {
+    pub fn set(&mut self, owner: usize, event: Event) {
         let old = self.slots[owner].time;
         if old < f64::INFINITY {
             self.unlink(owner, old);
@@ -290,20 +287,22 @@ impl Calendar {
             .unwrap_or(a)
     }
 
-    /// Prefetches particle `owner`'s slot and link.
+    /// Where reading `owner`'s event (its slot and link) or replacing it (the head of its
+    /// bucket; its slot should have arrived) touches first (see
+    /// [`EventQueue::footprint`](super::EventQueue::footprint)).
     #[inline]
-    pub fn prefetch_slot(&self, owner: usize) {
-        prefetch(&self.slots[owner]);
-        prefetch(&self.next[owner]);
-    }
-
-    /// Prefetches the head of the bucket `owner`'s event is in (its slot should have
-    /// arrived), which replacing the event reads.
-    #[inline]
-    pub fn prefetch_path(&self, owner: usize) {
-        let t = self.slots[owner].time;
-        if t < f64::INFINITY {
-            prefetch(&self.heads[(self.index(t) & self.mask) as usize]);
+    pub(crate) fn footprint(&self, owner: usize, reads: Reads, mut touch: impl FnMut(*const u8)) {
+        match reads {
+            Reads::Slot => {
+                touch((&self.slots[owner] as *const Slot).cast());
+                touch((&self.next[owner] as *const u32).cast());
+            }
+            Reads::Path => {
+                let t = self.slots[owner].time;
+                if t < f64::INFINITY {
+                    touch((&self.heads[(self.index(t) & self.mask) as usize] as *const u32).cast());
+                }
+            }
         }
     }
 

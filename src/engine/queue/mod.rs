@@ -1,4 +1,4 @@
-//! The event queue: one [`Pending`] event per particle, earliest first, in one of two
+//! The event queue: one [`Event`] event per particle, earliest first, in one of two
 //! structures with the same answers ([`EventQueue`]):
 //!
 //! * a **calendar** of time buckets ([`calendar`]): replacing an event unlinks it from a
@@ -13,20 +13,14 @@
 //! Every particle owns exactly one slot, so neither structure grows nor holds stale copies
 //! (a binary heap of every prediction held about five stale events per collision at packing
 //! fraction 0.65 and spent most of its time popping them). The order is the engine's total
-//! order ([`Pending::before`]): by time, then by kind, then by particles and axes — so the
+//! order ([`Event::before`]): by time, then by kind, then by particles and axes — so the
 //! earliest event never depends on how it was reached, nor on the structure.
 //!
-//! Measured (alternating runs on one core, `benches/compare.sh`, η = 0.65, medians of 10, 6,
-//! 4 and 2 runs, 10⁶ collisions/s, tree → calendar): 1.50 → 1.60 at N = 10⁴ (callgrind, the
-//! `x86-64-v3` build: 6 178 → 5 463 instructions per collision), 2.06 → 2.18 at 10³, 0.91 →
-//! 0.93 at 10⁵, and 0.85, 0.90 → 0.70, 0.64 at 10⁶; later, with the lookahead on for both
-//! (medians of 4): 1.015 → 1.034 at 10⁵ (within the noise) and 0.816 → 0.694 at 3·10⁵. So
-//! the calendar stops where the lookahead starts. In the criterion bench
-//! `engine/parts/queue_set_first/{tree,calendar}` (10⁴ events, the earliest moved later by a
-//! uniform step: times spread evenly, unlike an engine's, which crowd at the front) both take
-//! about 44 ns per search and update (one run each, 44.4 and 43.3 ns).
+//! The calendar is the faster of the two while the engine's state fits the caches; from
+//! [`CALENDAR_BELOW`] particles on, memory latency rules and the tree's prefetchable paths
+//! win (the measurements are in `benches/HISTORY.md`).
 
-use super::events::{Pending, PendingKind};
+use super::sources::{Event, EventKind};
 
 pub mod calendar;
 pub mod tree;
@@ -35,8 +29,7 @@ pub use calendar::Calendar;
 pub use tree::Tree;
 
 /// The calendar is used below this many particles, the tree from it on: about 6 MB of
-/// engine state, past which memory latency rules and the tree's prefetchable paths win (the
-/// calendar measured a tie at N = 10⁵ and 15–25 % slower from 3·10⁵ on).
+/// engine state, past which memory latency rules and the tree's prefetchable paths win.
 pub const CALENDAR_BELOW: usize = 3 << 14;
 
 /// Which structure an [`EventQueue`] uses.
@@ -55,9 +48,7 @@ impl QueueKind {
     }
 }
 
-/// A [`Pending`] event packed into 16 bytes: a pair is `(partner, partner's count)`; the
-/// other kinds put a tag that no particle index reaches (indices stay below
-/// [`MAX_PARTICLES`](crate::engine::simulation::MAX_PARTICLES)) where the partner would be.
+/// An [`Event`] packed into 16 bytes: its time and the two words of [`EventKind::pack`].
 #[derive(Clone, Copy, Debug)]
 #[repr(C)]
 pub(super) struct Slot {
@@ -66,36 +57,26 @@ pub(super) struct Slot {
     what: u32,
 }
 
-const NOTHING_TAG: u32 = u32::MAX;
-const WALL_TAG: u32 = u32::MAX - 1;
-const REBUILD_TAG: u32 = u32::MAX - 2;
-
 impl Slot {
     #[inline(always)]
-    pub(super) fn pack(e: Pending) -> Slot {
-        let (who, what) = match e.kind {
-            PendingKind::Pair { partner, partner_events } => {
-                debug_assert!(partner < REBUILD_TAG);
-                (partner, partner_events)
-            }
-            PendingKind::Wall { axis, upper } => (WALL_TAG, axis as u32 | (upper as u32) << 8),
-            PendingKind::Rebuild => (REBUILD_TAG, 0),
-            PendingKind::Nothing => (NOTHING_TAG, 0),
-        };
+    pub(super) fn pack(e: Event) -> Slot {
+        let (who, what) = e.kind.pack();
         Slot { time: e.time, who, what }
     }
 
     #[inline(always)]
-    pub(super) fn unpack(self) -> Pending {
-        let (axis, flag) = (self.what as u8, self.what >> 8 != 0);
-        let kind = match self.who {
-            NOTHING_TAG => PendingKind::Nothing,
-            WALL_TAG => PendingKind::Wall { axis, upper: flag },
-            REBUILD_TAG => PendingKind::Rebuild,
-            partner => PendingKind::Pair { partner, partner_events: self.what },
-        };
-        Pending { time: self.time, kind }
+    pub(super) fn unpack(self) -> Event {
+        Event { time: self.time, kind: EventKind::unpack(self.who, self.what) }
     }
+}
+
+/// Which of a particle's places in the queue [`EventQueue::footprint`] names.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(crate) enum Reads {
+    /// Its slot (and the calendar's link).
+    Slot,
+    /// What replacing its event walks first.
+    Path,
 }
 
 /// One pending event per particle, earliest first: a [`Calendar`] or a [`Tree`].
@@ -108,9 +89,8 @@ pub enum EventQueue {
 }
 
 impl EventQueue {
-    /// A queue over `pending` (one event per particle, at most
-    /// [`MAX_PARTICLES`](super::simulation::MAX_PARTICLES)).
-    pub fn new(pending: Vec<Pending>, kind: QueueKind) -> Self {
+    /// A queue over `pending` (one event per particle, at most [`MAX_PARTICLES`]).
+    pub fn new(pending: Vec<Event>, kind: QueueKind) -> Self {
         match kind {
             QueueKind::Calendar => EventQueue::Calendar(Calendar::new(pending)),
             QueueKind::Tree => EventQueue::Tree(Tree::new(pending)),
@@ -134,7 +114,7 @@ impl EventQueue {
     }
 
     /// The pending events, by owner.
-    pub fn pending(&self) -> Vec<Pending> {
+    pub fn pending(&self) -> Vec<Event> {
         match self {
             EventQueue::Calendar(q) => q.pending(),
             EventQueue::Tree(q) => q.pending(),
@@ -143,7 +123,7 @@ impl EventQueue {
 
     /// Particle `owner`'s pending event.
     #[inline]
-    pub fn get(&self, owner: usize) -> Pending {
+    pub fn get(&self, owner: usize) -> Event {
         match self {
             EventQueue::Calendar(q) => q.get(owner),
             EventQueue::Tree(q) => q.get(owner),
@@ -152,7 +132,7 @@ impl EventQueue {
 
     /// The owner of the earliest event, and the event (`&mut`: the calendar moves its cursor).
     #[inline]
-    pub fn first(&mut self) -> (usize, Pending) {
+    pub fn first(&mut self) -> (usize, Event) {
         match self {
             EventQueue::Calendar(q) => q.first(),
             EventQueue::Tree(q) => q.first(),
@@ -161,7 +141,7 @@ impl EventQueue {
 
     /// Replaces particle `owner`'s pending event.
     #[inline]
-    pub fn set(&mut self, owner: usize, event: Pending) {
+    pub fn set(&mut self, owner: usize, event: Event) {
         match self {
             EventQueue::Calendar(q) => q.set(owner, event),
             EventQueue::Tree(q) => q.set(owner, event),
@@ -190,22 +170,22 @@ impl EventQueue {
         }
     }
 
-    /// Prefetches particle `owner`'s slot.
+    /// Where the memory is that reading `owner`'s event ([`Reads::Slot`]) or replacing it
+    /// ([`Reads::Path`]: the lowest levels of its tree path, or its bucket's head) touches
+    /// first — for the timing room to prefetch: `touch` is given each place.
     #[inline]
-    pub fn prefetch_slot(&self, owner: usize) {
+    pub(crate) fn footprint(&self, owner: usize, reads: Reads, touch: impl FnMut(*const u8)) {
         match self {
-            EventQueue::Calendar(q) => q.prefetch_slot(owner),
-            EventQueue::Tree(q) => q.prefetch_slot(owner),
+            EventQueue::Calendar(q) => q.footprint(owner, reads, touch),
+            EventQueue::Tree(q) => q.footprint(owner, reads, touch),
         }
     }
 
-    /// Prefetches what replacing `owner`'s event will read first: the lowest levels of its
-    /// tree path, or its bucket's head.
-    #[inline]
-    pub fn prefetch_path(&self, owner: usize) {
+    /// The large arrays, for the timing room (which may move them into huge pages).
+    pub(crate) fn large_arrays(&mut self) -> Vec<&mut dyn super::timing::LargeArray> {
         match self {
-            EventQueue::Calendar(q) => q.prefetch_path(owner),
-            EventQueue::Tree(q) => q.prefetch_path(owner),
+            EventQueue::Calendar(_) => Vec::new(),
+            EventQueue::Tree(q) => q.large_arrays(),
         }
     }
 
@@ -232,33 +212,33 @@ mod tests {
     use super::*;
 
     const KINDS: [QueueKind; 2] = [QueueKind::Calendar, QueueKind::Tree];
-    use crate::engine::events::PendingKind;
+    use crate::engine::sources::{EventKind, MAX_PARTICLES};
     use rand::rngs::Xoshiro256PlusPlus;
     use rand::{RngExt, SeedableRng};
 
-    fn wall(time: f64) -> Pending {
-        Pending { time, kind: PendingKind::Wall { axis: 0, upper: true } }
+    fn wall(time: f64) -> Event {
+        Event { time, kind: EventKind::Wall { axis: 0, upper: true } }
     }
 
     /// Every kind of event comes back out of its 16-byte slot as it went in, at the
     /// extremes of every field.
     #[test]
     fn slots_keep_every_event() {
-        let largest = crate::engine::simulation::MAX_PARTICLES as u32 - 1;
-        let mut kinds = vec![PendingKind::Nothing, PendingKind::Rebuild];
+        let largest = MAX_PARTICLES as u32 - 1;
+        let mut kinds = vec![EventKind::Nothing, EventKind::Rebuild];
         for axis in [0u8, 1, 2] {
             for flag in [false, true] {
-                kinds.push(PendingKind::Wall { axis, upper: flag });
+                kinds.push(EventKind::Wall { axis, upper: flag });
             }
         }
         for partner in [0, 1, largest] {
             for partner_events in [0, 1, u32::MAX] {
-                kinds.push(PendingKind::Pair { partner, partner_events });
+                kinds.push(EventKind::Pair { partner, partner_events });
             }
         }
         for kind in kinds {
             for time in [0.0, -0.0, 1.5, f64::MIN_POSITIVE, f64::INFINITY] {
-                let e = Pending { time, kind };
+                let e = Event { time, kind };
                 let back = Slot::pack(e).unpack();
                 assert_eq!((back.time.to_bits(), back.kind), (time.to_bits(), kind));
             }
@@ -271,12 +251,12 @@ mod tests {
     fn first_is_the_minimum_in_the_total_order() {
         let mut rng = Xoshiro256PlusPlus::seed_from_u64(5);
         for (n, kind) in [1usize, 2, 3, 4, 5, 6, 7, 8, 13, 100].into_iter().flat_map(|n| KINDS.map(|k| (n, k))) {
-            let mut queue = EventQueue::new((0..n).map(|_| Pending::NOTHING).collect(), kind);
+            let mut queue = EventQueue::new((0..n).map(|_| Event::NOTHING).collect(), kind);
             for _ in 0..2000 {
                 let owner = rng.random_range(0..n);
                 // Few distinct times, so that ties are common; sometimes nothing.
                 let r: u32 = rng.random_range(0..9);
-                let event = if r == 8 { Pending::NOTHING } else { wall(r as f64) };
+                let event = if r == 8 { Event::NOTHING } else { wall(r as f64) };
                 queue.set(owner, event);
                 let (got, _) = queue.first();
                 let want = (0..n)
@@ -343,7 +323,7 @@ mod tests {
                     if n > 2 && step % 997 == 0 {
                         // A stretch where one particle is pending and everyone else is not.
                         for k in 1..n {
-                            queue.set(k, Pending::NOTHING);
+                            queue.set(k, Event::NOTHING);
                         }
                     }
                 }
@@ -363,7 +343,7 @@ mod tests {
         for n in [300usize, 1000, 1100, 5000, 20_000] {
             let skip = tree::guess_levels(n);
             assert!(skip >= 1, "n = {n}");
-            let mut queue = EventQueue::new((0..n).map(|_| Pending::NOTHING).collect(), QueueKind::Tree);
+            let mut queue = EventQueue::new((0..n).map(|_| Event::NOTHING).collect(), QueueKind::Tree);
             for k in 0..n {
                 queue.set(k, wall(rng.random_range(0.0..1.0)));
             }
@@ -406,7 +386,7 @@ mod tests {
     fn runner_up_is_the_earliest_of_the_others() {
         let mut rng = Xoshiro256PlusPlus::seed_from_u64(11);
         for (n, kind) in [3usize, 4, 5, 6, 7, 13, 100, 1000].into_iter().flat_map(|n| KINDS.map(|k| (n, k))) {
-            let mut queue = EventQueue::new((0..n).map(|_| Pending::NOTHING).collect(), kind);
+            let mut queue = EventQueue::new((0..n).map(|_| Event::NOTHING).collect(), kind);
             for _ in 0..2000 {
                 let owner = rng.random_range(0..n);
                 queue.set(owner, wall(rng.random_range(0.0..1.0)));

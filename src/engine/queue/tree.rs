@@ -1,4 +1,4 @@
-//! The tournament tree: one [`Pending`] event per particle in a 4-ary tree of winners.
+//! The tournament tree: one [`Event`] event per particle in a 4-ary tree of winners.
 //!
 //! Every particle owns exactly one slot, so the queue never grows and never holds stale
 //! copies (a binary heap of every prediction held about five stale events per collision at
@@ -9,20 +9,17 @@
 //! four children, which makes `m = (slots − 1)/3` — about N/3 nodes of 16 bytes. Each
 //! internal node keeps the time and owner of the earliest event below it, so replacing one
 //! particle's event walks one path of ⌈log₄ N⌉ nodes, comparing the four children of each
-//! node on it as two independent pairs. Against the binary tree it replaced, an update of
-//! the root's owner costs the same (63 ns in `engine/parts/queue_set_root` — now
-//! `queue_set_first/tree` —, three interleaved runs each), the tree takes a third of the
-//! memory (N/3 nodes instead of N), and the whole engine measured +5 % (median of five
-//! interleaved runs, within the noise).
+//! node on it as two independent pairs. Against a binary tree, an update costs about the
+//! same and the tree takes a third of the memory (N/3 nodes instead of N).
 //! The four children of a node share one cache line (see [`Tree`]): 16 bytes per
 //! particle for the events and about 5 for the nodes.
 //!
-//! The order is the engine's total order ([`Pending::before`]): by time, then by kind, then
+//! The order is the engine's total order ([`Event::before`]): by time, then by kind, then
 //! by particles and axes — so the earliest event never depends on how it was reached.
 
+use super::Reads;
 use super::Slot;
-use crate::engine::events::Pending;
-use crate::engine::pages;
+use crate::engine::sources::{Event, MAX_PARTICLES};
 
 /// Children per internal node.
 const ARITY: usize = 4;
@@ -87,9 +84,8 @@ pub(super) fn guess_levels(n: usize) -> usize {
 pub(super) const TOP: usize = 21;
 
 impl Tree {
-    /// A queue over `pending` (one event per particle, at most
-    /// [`MAX_PARTICLES`](crate::engine::simulation::MAX_PARTICLES)).
-    pub fn new(pending: Vec<Pending>) -> Self {
+    /// A queue over `pending` (one event per particle, at most [`MAX_PARTICLES`]).
+    pub fn new(pending: Vec<Event>) -> Self {
         let mut queue = Tree::nothing(pending.len());
         for (p, e) in pending.into_iter().enumerate() {
             *queue.slot_mut(p) = Slot::pack(e);
@@ -101,7 +97,7 @@ impl Tree {
     /// A queue of `n` particles with nothing pending (no temporary list of events: at
     /// N = 10⁶ one cost 24 MB of peak memory).
     pub fn nothing(n: usize) -> Self {
-        assert!(n >= 1 && n <= crate::engine::simulation::MAX_PARTICLES, "1 ≤ n ≤ 2³² − 5 particles");
+        assert!(n >= 1 && n <= MAX_PARTICLES, "1 ≤ n ≤ 2³² − 5 particles");
         let mut slots = n;
         while (slots - 1) % (ARITY - 1) != 0 {
             slots += 1;
@@ -109,14 +105,14 @@ impl Tree {
         let m = (slots - 1) / (ARITY - 1);
         // The children of node k begin at tree position 4k + 1, slot 4k + 1 − m.
         let shift = (m + ARITY - 1) % ARITY;
-        let empty = Group([Slot::pack(Pending::NOTHING); ARITY]);
+        let empty = Group([Slot::pack(Event::NOTHING); ARITY]);
         let mut queue = Tree {
-            groups: pages::filled((slots + shift).div_ceil(ARITY), empty),
+            groups: vec![empty; (slots + shift).div_ceil(ARITY)],
             shift,
             n,
             m,
             root: NO_NODE,
-            quads: pages::filled(m.saturating_sub(1).div_ceil(ARITY), Quad([NO_NODE; ARITY])),
+            quads: vec![Quad([NO_NODE; ARITY]); m.saturating_sub(1).div_ceil(ARITY)],
             skip: guess_levels(n),
         };
         // Built even though every time is +∞: the winners of those ties are decided by the
@@ -161,27 +157,27 @@ impl Tree {
     }
 
     /// The pending events, by owner.
-    pub fn pending(&self) -> Vec<Pending> {
+    pub fn pending(&self) -> Vec<Event> {
         (0..self.n).map(|p| self.get(p)).collect()
     }
 
     /// Particle `owner`'s pending event.
     #[inline]
-    pub fn get(&self, owner: usize) -> Pending {
+    pub fn get(&self, owner: usize) -> Event {
         assert!(owner < self.n, "particle {owner} of {}", self.n);
         self.slot(owner).unpack()
     }
 
     /// The owner of the earliest event, and the event.
     #[inline]
-    pub fn first(&self) -> (usize, Pending) {
+    pub fn first(&self) -> (usize, Event) {
         let owner = if self.m == 0 { 0 } else { self.root.owner as usize };
         (owner, self.slot(owner).unpack())
     }
 
     /// Replaces particle `owner`'s pending event.
     #[inline]
-    pub fn set(&mut self, owner: usize, event: Pending) {
+    pub fn set(&mut self, owner: usize, event: Event) {
         assert!(owner < self.n, "particle {owner} of {}", self.n);
         *self.slot_mut(owner) = Slot::pack(event);
         let mut k = self.m + owner;
@@ -210,13 +206,10 @@ impl Tree {
     ///
     /// Why not [`runner_up`](Self::runner_up): its walk starts at the slots, and the lowest
     /// levels of both paths are the ones out of cache (the upper levels are shared by every
-    /// walk); at N = 10⁵ the lookahead's first stage was a fifth of the engine's time, most of
-    /// it this walk. Leaving out 2·4^s of N particles, the guess was right (the owner of the
-    /// next step's event) 98.7 % of the time at N = 10⁵ with s = 5, against 99.9 % with the
-    /// whole walk (4.1·10⁶ steps counted, η = 0.65), and N = 10⁵ ran 13–14 % faster with
-    /// s = 3 and 7 % faster again with s = 5 (s = 6: 7 % slower; alternating runs, see
-    /// `benches/HISTORY.md`). A wrong guess costs only time: the results are the same bit
-    /// for bit.
+    /// walk). Leaving out two small subtrees makes the guess wrong now and then (when the
+    /// next event's owner is near the pair in the tree), but shortens the walk to the levels
+    /// that stay in cache; the trade was measured over `s` (`benches/HISTORY.md`). A wrong
+    /// guess costs only time: the results are the same bit for bit.
     #[inline]
     pub fn guess_next(&self, a: usize, b: usize) -> usize {
         self.earliest_beside(a, b, self.skip)
@@ -248,16 +241,15 @@ impl Tree {
         best_owner as usize
     }
 
-    /// Prefetches particle `owner`'s slot.
+    /// Where reading `owner`'s event (its slot) or replacing it (the lowest levels of the path
+    /// above its slot, one line per level: the upper levels stay in cache) touches first (see
+    /// [`EventQueue::footprint`](super::EventQueue::footprint)).
     #[inline]
-    pub fn prefetch_slot(&self, owner: usize) {
-        crate::engine::prefetch::prefetch(self.slot(owner));
-    }
-
-    /// Prefetches the lowest levels of the path above `owner`'s slot (the upper levels stay
-    /// in cache): one line per level.
-    #[inline]
-    pub fn prefetch_path(&self, owner: usize) {
+    pub(crate) fn footprint(&self, owner: usize, reads: Reads, mut touch: impl FnMut(*const u8)) {
+        if reads == Reads::Slot {
+            touch((self.slot(owner) as *const Slot).cast());
+            return;
+        }
         let m = self.m;
         let mut k = m + owner;
         for _ in 0..4 {
@@ -267,11 +259,16 @@ impl Tree {
             k = (k - 1) / ARITY;
             let c = ARITY * k + 1;
             if c >= m {
-                crate::engine::prefetch::prefetch(&self.groups[(c - m + self.shift) / ARITY]);
+                touch((&self.groups[(c - m + self.shift) / ARITY] as *const Group).cast());
             } else if let Some(quad) = self.quads.get(k) {
-                crate::engine::prefetch::prefetch(quad);
+                touch((quad as *const Quad).cast());
             }
         }
+    }
+
+    /// The large arrays, for the timing room (which may move them into huge pages).
+    pub(crate) fn large_arrays(&mut self) -> Vec<&mut dyn crate::engine::timing::LargeArray> {
+        vec![&mut self.groups, &mut self.quads]
     }
 
     /// Internal nodes, the root included (tree position `m + p` is slot `p`).
@@ -325,9 +322,8 @@ impl Tree {
     fn earlier(&self, a: Node, b: Node) -> Node {
         let b_first = if a.time == b.time { self.tie_b_first(a, b) } else { b.time < a.time };
         // The winner's time is the smaller one (equal times are equal as f64, whichever wins
-        // the tie), so no branch picks it: written as an `if`, the compiler branched on it
-        // (it has no conditional move for an f64), and those branches were a third of the
-        // engine's mispredictions (callgrind's branch simulation at N = 10⁴, η = 0.65).
+        // the tie), so no branch picks it: written as an `if`, the compiler branches on it (it
+        // has no conditional move for an f64), and those branches mispredict half the time.
         Node { time: a.time.min(b.time), owner: std::hint::select_unpredictable(b_first, b.owner, a.owner) }
     }
 

@@ -2,16 +2,15 @@
 //!
 //! At large N nearly every access of an event's data goes to a random place in arrays of
 //! tens of megabytes; with 4 KB pages it then misses the TLB as well as the cache, and the
-//! page walk delays even the lookahead's prefetches (`perf` put most of the time of the
-//! lookahead's first stage right after the prefetch of the next event's record, N = 10⁶).
-//! Linux backs memory with 2 MB pages when asked (`madvise(MADV_HUGEPAGE)`; this machine
-//! kind's `/sys/kernel/mm/transparent_hugepage/enabled` is `madvise`, and the kernel does it
-//! unasked under `always`). The request is made before the first touch, because the
-//! kernel chooses the page size when a page is first written.
+//! page walk delays even the lookahead's prefetches. Linux backs memory with 2 MB pages when
+//! asked (`madvise(MADV_HUGEPAGE)` where `/sys/kernel/mm/transparent_hugepage/enabled` is
+//! `madvise`; unasked under `always`). The kernel chooses the page size when a page is first
+//! written, so an array is moved into a new allocation that was advised before the copy
+//! ([`LargeArray::settle`]).
 //!
-//! The arrays built here are the particles, the neighbour lists and centres, and the
-//! tournament tree — about nine tenths of the engine's memory at N = 10⁶. Where huge pages
-//! are not available (another system, `never`, or no free 2 MB page), the request does
+//! The arrays moved are the particles, the neighbour lists and centres, the cells' links and
+//! the tournament tree — about nine tenths of the engine's memory at large N. Where huge
+//! pages are not available (another system, `never`, or no free 2 MB page), the request does
 //! nothing and the pages stay small: the results are the same bit for bit either way, only
 //! the speed differs.
 
@@ -20,6 +19,20 @@ const FROM_BYTES: usize = 4 << 20;
 
 /// The size of a huge page (x86-64 and aarch64 with 4 KB base pages).
 const HUGE: usize = 2 << 20;
+
+/// One of the engine's arrays, which the timing room may move into memory backed by huge
+/// pages: the elements, their order and the length stay as they were.
+pub(crate) trait LargeArray {
+    /// Moves the elements into memory advised for huge pages, if the array is large enough
+    /// for that to matter ([`moved`]).
+    fn settle(&mut self);
+}
+
+impl<T> LargeArray for Vec<T> {
+    fn settle(&mut self) {
+        *self = moved(std::mem::take(self));
+    }
+}
 
 /// `items` in a new vector whose memory was advised to be backed by huge pages before it
 /// was written (when it is at least `FROM_BYTES`; else an ordinary vector).

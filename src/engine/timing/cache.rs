@@ -1,5 +1,5 @@
 //! The size of the processor's level-2 cache, which sets where the lookahead pays
-//! ([`Simulation`](super::Simulation) prefetches the next event's data only once the engine's
+//! ([`Simulation`](crate::engine::Simulation) prefetches the next event's data only once the engine's
 //! state has left that cache). Timing only: the events are the same bit for bit whatever it
 //! is, and wherever it cannot be read.
 
@@ -8,7 +8,7 @@ use std::sync::OnceLock;
 /// The size in bytes of the first CPU's unified level-2 cache, as Linux reports it under
 /// `/sys/devices/system/cpu/cpu0/cache/index*/` (`level`, `type`, `size`); `None` on other
 /// systems or when it cannot be read. Read once per process.
-pub fn level2_bytes() -> Option<usize> {
+pub(crate) fn level2_bytes() -> Option<usize> {
     static SIZE: OnceLock<Option<usize>> = OnceLock::new();
     *SIZE.get_or_init(|| {
         let read = |dir: &std::path::Path, file: &str| std::fs::read_to_string(dir.join(file)).ok();
@@ -22,7 +22,7 @@ pub fn level2_bytes() -> Option<usize> {
 }
 
 /// A cache size as sysfs writes it: bytes, or a number with `K`, `M` or `G` (powers of 1024).
-pub fn parse_size(text: &str) -> Option<usize> {
+pub(crate) fn parse_size(text: &str) -> Option<usize> {
     let (digits, unit) = match text.char_indices().last()? {
         (at, 'K') => (&text[..at], 1 << 10),
         (at, 'M') => (&text[..at], 1 << 20),

@@ -1,4 +1,5 @@
-//! The benchmark report: steady-state collisions per second across N and packing fraction.
+//! The benchmarks: steady-state collisions per second across N and packing fraction, beside
+//! the hardware's floor ([`floor`]) measured in the same process.
 //!
 //! Each point builds a periodic box from a triangular lattice (Maxwell velocities, kT = 1),
 //! runs a warm-up that is not timed (so the lattice has melted and the queue has reached its
@@ -7,9 +8,13 @@
 //! the event queue, the neighbour lists and their grid) and the process's peak resident set size when each point
 //! runs in a process of its own (`collide bench` does that).
 
-use super::plot::{Chart, Series};
-use crate::engine::init::{Placement, Species, Velocities, box_for_packing_fraction, initial_particles};
-use crate::engine::{Boundary, EventCounts, Neighbourhood, Particle, SimBox, Simulation};
+pub mod floor;
+pub mod state;
+
+pub use state::{BenchError, initial_state};
+
+use crate::engine::{EventCounts, Neighbourhood, Simulation};
+use crate::lab::plot::{Chart, Series};
 use serde::{Deserialize, Serialize};
 use std::time::Instant;
 
@@ -73,25 +78,6 @@ pub fn peak_rss_bytes() -> Option<u64> {
     Some(kb * 1024)
 }
 
-/// A benchmark point's initial state: N disks of diameter 1 on a triangular lattice at
-/// packing fraction `eta` in a periodic box, Maxwell velocities at kT = 1 (the engine's and
-/// the floor's, [`super::floor`], alike).
-pub fn initial_state(n: usize, eta: f64, seed: u64) -> Result<(Vec<Particle<2>>, SimBox<2>), String> {
-    // Close packing of equal disks: π/(2√3) ≈ 0.9069.
-    if !(eta > 0.0 && eta < 0.9069) {
-        return Err(format!("--eta {eta}: the packing fraction must lie in (0, 0.9069) (close packing is π/(2√3))"));
-    }
-    if n < 2 {
-        return Err(format!("--n {n}: a benchmark needs at least 2 disks"));
-    }
-    crate::run::Limits::for_this_machine().check_memory("--n", n, 0.0).map_err(|e| e.to_string())?;
-    let species = vec![Species { count: n, radius: 0.5, mass: 1.0 }];
-    let sim_box = box_for_packing_fraction(&species, eta, [Boundary::Periodic; 2], Placement::Triangular, None);
-    let particles = initial_particles(&species, &sim_box, Placement::Triangular, Velocities::Maxwell, 1.0, seed)
-        .map_err(|e| e.to_string())?;
-    Ok((particles, sim_box))
-}
-
 /// Measures one point: `warmup_per_particle` untimed collisions per particle, then
 /// `timed` collisions, with the neighbourhood asked for.
 pub fn measure(
@@ -101,28 +87,27 @@ pub fn measure(
     warmup_per_particle: u64,
     timed: u64,
     seed: u64,
-) -> Result<BenchPoint, String> {
+) -> Result<BenchPoint, BenchError> {
     let (particles, sim_box) = initial_state(n, eta, seed)?;
-    let mut sim = Simulation::with_neighbourhood(particles, sim_box, neighbourhood).map_err(|e| e.to_string())?;
+    let mut sim = Simulation::with_neighbourhood(particles, sim_box, neighbourhood).map_err(BenchError::Setup)?;
     let warmup = warmup_per_particle * n as u64;
     while sim.counts().pair < warmup {
-        sim.step().ok_or("the gas stopped")?;
+        sim.step().ok_or(BenchError::Stopped)?;
     }
     let before = sim.counts();
     let start = Instant::now();
     let target = before.pair + timed;
     while sim.counts().pair < target {
-        sim.step().ok_or("the gas stopped")?;
+        sim.step().ok_or(BenchError::Stopped)?;
     }
     let seconds = start.elapsed().as_secs_f64();
     let events_by_kind = sim.counts().since(&before);
     let (engine_bytes, crowded, lists) = (sim.memory_bytes(), sim.crowded(), sim.lists());
     // Read before the floor allocates; the engine's memory goes first.
-    let (peak_rss_bytes, huge_page_bytes) = (peak_rss_bytes(), crate::engine::pages::huge_page_bytes());
+    let (peak_rss_bytes, huge_page_bytes) = (peak_rss_bytes(), crate::engine::internals::huge_page_bytes());
     drop(sim);
     // (The floor needs a full row of neighbours: none below 2·WIDTH disks.)
-    let floor =
-        (n >= 2 * super::floor::WIDTH).then(|| super::floor::measure(n, eta, 2 * n as u64, timed, seed)).transpose()?;
+    let floor = (n >= 2 * floor::WIDTH).then(|| floor::measure(n, eta, 2 * n as u64, timed, seed)).transpose()?;
     let collisions_per_second = timed as f64 / seconds;
     Ok(BenchPoint {
         n_particles: n,

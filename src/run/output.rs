@@ -1,6 +1,7 @@
 //! A run's files and how `collide run` writes them: `summary.json`, `timeseries.csv`,
 //! `trajectory.xyz` (extended XYZ), `checkpoint.json`, in a directory that holds one run
-//! ([`crate::io::rundir`]: the policy, the lock, the atomic writes).
+//! ([`super::rundir`]: the policy, the lock, the atomic writes). The formats are specified
+//! in `docs/outputs.md`.
 //!
 //! [`Writer`] is the [`Sink`] of a run: it appends a trajectory frame every
 //! `trajectory_every` samples and writes a checkpoint every `checkpoint_every` production
@@ -8,21 +9,21 @@
 //! trajectory, writes the final checkpoint (not for a stalled run, whose state would stall
 //! again), the time series and, last, the summary.
 
+use super::config::Config;
+pub use super::rundir::{OutputError, write_atomic};
+use super::rundir::{RunDir, Trajectory};
+use super::{Checkpoint, Phase, Run, RunError, Sink, Status, Summary};
 use crate::engine::{Boundary, Outcome, Simulation};
-use crate::io::config::Config;
-pub use crate::io::rundir::{OutputError, write_atomic};
-use crate::io::rundir::{RunDir, Trajectory};
-use crate::run::{Checkpoint, Phase, Run, RunError, Sink, Status, Summary};
 use std::fmt::Write as _;
 use std::path::Path;
 use std::sync::atomic::AtomicBool;
 
 /// The time series as CSV: one row per sample.
-pub fn timeseries_csv(run: &Run) -> String {
-    let walls: Vec<usize> = (0..2).filter(|&a| run.sim.sim_box().boundary[a] == Boundary::Wall).collect();
+pub fn timeseries_csv<const D: usize>(run: &Run<D>) -> String {
+    let walls: Vec<usize> = (0..D).filter(|&a| run.sim.sim_box().boundary[a] == Boundary::Wall).collect();
     let mut out = String::from("t,kinetic_energy,kT,collisions,pressure_virial");
     for &a in &walls {
-        let axis = ["x", "y"][a];
+        let axis = ["x", "y", "z"][a];
         write!(out, ",pressure_wall_{axis}_lower,pressure_wall_{axis}_upper").unwrap();
     }
     out.push('\n');
@@ -54,34 +55,38 @@ pub fn species_symbol(k: u32) -> &'static str {
     ELEMENTS.get(k as usize).copied().unwrap_or("X")
 }
 
-/// One extended-XYZ frame (OVITO and ASE read it): 2D positions written with z = 0; the
-/// `species` column names each species by a chemical symbol ([`species_symbol`]: OVITO
-/// makes it the particle type, ASE the symbols), then the radius and the species index
-/// (`species_index`, a column of its own that neither reads as a type).
-pub fn xyz_frame(sim: &Simulation<2>) -> String {
+/// One extended-XYZ frame (OVITO and ASE read it): positions wrapped into the box, with
+/// z = 0 in 2D; the `species` column names each species by a chemical symbol
+/// ([`species_symbol`]: OVITO makes it the particle type, ASE the symbols), then the radius
+/// and the species index (`species_index`, a column of its own that neither reads as a type).
+pub fn xyz_frame<const D: usize>(sim: &Simulation<D>) -> String {
     let b = sim.sim_box();
-    let pbc = |a: usize| if b.boundary[a] == Boundary::Periodic { "T" } else { "F" };
+    let length = |a: usize| if a < D { b.lengths[a] } else { 1.0 };
+    let pbc = |a: usize| if a < D && b.boundary[a] == Boundary::Periodic { "T" } else { "F" };
     let mut out = String::new();
     writeln!(out, "{}", sim.particles().len()).unwrap();
     writeln!(
         out,
-        "Lattice=\"{} 0.0 0.0 0.0 {} 0.0 0.0 0.0 1.0\" Properties=species:S:1:pos:R:3:radius:R:1:species_index:I:1 Time={} pbc=\"{} {} F\"",
-        b.lengths[0],
-        b.lengths[1],
+        "Lattice=\"{} 0.0 0.0 0.0 {} 0.0 0.0 0.0 {}\" Properties=species:S:1:pos:R:3:radius:R:1:species_index:I:1 Time={} pbc=\"{} {} {}\"",
+        length(0),
+        length(1),
+        if D > 2 { length(2).to_string() } else { "1.0".to_string() },
         sim.time(),
         pbc(0),
-        pbc(1)
+        pbc(1),
+        pbc(2)
     )
     .unwrap();
     for (p, r) in sim.particles().iter().zip(sim.wrapped_positions()) {
-        writeln!(out, "{} {} {} 0.0 {} {}", species_symbol(p.species), r[0], r[1], p.radius, p.species).unwrap();
+        let z = if D > 2 { r[2].to_string() } else { "0.0".to_string() };
+        writeln!(out, "{} {} {} {z} {} {}", species_symbol(p.species), r[0], r[1], p.radius, p.species).unwrap();
     }
     out
 }
 
-/// Reads a checkpoint file (verified: see [`Checkpoint::load`]); errors name the file.
-pub fn load_checkpoint(path: &Path) -> Result<Checkpoint, String> {
-    Checkpoint::load(path).map_err(|e| format!("{}: {e}", path.display()))
+/// Reads a checkpoint file (verified: see [`Checkpoint::load`]).
+pub fn load_checkpoint<const D: usize>(path: &Path) -> Result<Checkpoint<D>, super::CheckpointError> {
+    Checkpoint::load(path)
 }
 
 /// The [`Sink`] of `collide run`: the trajectory and the checkpoints, while the run goes.
@@ -103,10 +108,10 @@ impl<P: FnMut(Phase, f64)> Writer<'_, P> {
     }
 }
 
-impl<P: FnMut(Phase, f64)> Sink for Writer<'_, P> {
+impl<const D: usize, P: FnMut(Phase, f64)> Sink<D> for Writer<'_, P> {
     type Error = OutputError;
 
-    fn event(&mut self, run: &Run, outcome: &Outcome<2>) -> Result<(), OutputError> {
+    fn event(&mut self, run: &Run<D>, outcome: &Outcome<D>) -> Result<(), OutputError> {
         if run.phase() != Phase::Production {
             return Ok(());
         }
@@ -133,13 +138,13 @@ impl<P: FnMut(Phase, f64)> Sink for Writer<'_, P> {
 }
 
 /// How `collide run` starts.
-pub enum Start<'a> {
+pub enum Start<'a, const D: usize> {
     /// From a configuration.
     Fresh(Config),
     /// From a checkpoint file, already read.
     Resume {
         /// The checkpoint.
-        checkpoint: Checkpoint,
+        checkpoint: Checkpoint<D>,
         /// Its file.
         path: &'a Path,
     },
@@ -180,8 +185,8 @@ pub struct RunOptions {
 /// (refusing another run's files unless `options.force`), runs both phases until done,
 /// stopped by `stop` or by the watchdog, and writes every file. `progress` is told the
 /// phase and the fraction of it done now and then.
-pub fn run_into(
-    start: Start<'_>,
+pub fn run_into<const D: usize>(
+    start: Start<'_, D>,
     dir: &Path,
     options: RunOptions,
     stop: &AtomicBool,
@@ -230,8 +235,8 @@ pub fn run_into(
 
 /// Writes the files of a run that has ended with `status`: the trajectory flushed, the
 /// final checkpoint (not after a stall), the time series, and the summary last.
-fn finish<P: FnMut(Phase, f64)>(
-    run: &Run,
+fn finish<const D: usize, P: FnMut(Phase, f64)>(
+    run: &Run<D>,
     writer: &mut Writer<'_, P>,
     status: Status,
     warnings: Vec<String>,

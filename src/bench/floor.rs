@@ -34,9 +34,10 @@
 //! eight straddled two lines, and N = 10⁶ took 340–400 ns a collision against 150–280);
 //! lists are 32 bytes a row, partners 4 bytes and due times 8.
 
+use super::state::{BenchError, initial_state};
 use crate::engine::SimBox;
-use crate::engine::pages;
-use crate::engine::prefetch::prefetch;
+use crate::engine::internals::pages;
+use crate::engine::internals::prefetch;
 use rand::rngs::Xoshiro256PlusPlus;
 use rand::{RngExt, SeedableRng};
 use serde::{Deserialize, Serialize};
@@ -92,11 +93,15 @@ pub struct Floor {
 impl Floor {
     /// The floor for N disks of diameter 1 at packing fraction `eta`, from the benchmark
     /// report's initial state (triangular lattice, Maxwell velocities, kT = 1, periodic).
-    pub fn new(n: usize, eta: f64, seed: u64) -> Result<Floor, String> {
+    pub fn new(n: usize, eta: f64, seed: u64) -> Result<Floor, BenchError> {
         if n < 2 * WIDTH {
-            return Err(format!("the floor needs at least {} disks, got {n}", 2 * WIDTH));
+            return Err(BenchError::Option {
+                flag: "n",
+                value: n.to_string(),
+                allowed: "the floor needs at least 16 disks (two full rows of neighbours)",
+            });
         }
-        let (particles, sim_box) = super::bench::initial_state(n, eta, seed)?;
+        let (particles, sim_box) = initial_state(n, eta, seed)?;
         // In 2 MB pages where large, as the engine's arrays (`engine::pages`).
         let disks: Vec<Disk> = pages::collect(particles.iter().map(|p| Disk {
             position: p.position.into(),
@@ -365,8 +370,8 @@ fn nearest(disks: &[Disk], sim_box: &SimBox<2>, brute: bool) -> Vec<[u32; WIDTH]
 /// Measures the floor: `warmup` untimed collisions, then `timed` timed ones, without and
 /// with the lookahead ([`Floor::run`]), the same disks drawn by a seeded generator either
 /// way. The floor is the faster of the two ([`measure`]; the lookahead pays at large N).
-pub fn measure_both(n: usize, eta: f64, warmup: u64, timed: u64, seed: u64) -> Result<[FloorPoint; 2], String> {
-    let one = |lookahead| -> Result<FloorPoint, String> {
+pub fn measure_both(n: usize, eta: f64, warmup: u64, timed: u64, seed: u64) -> Result<[FloorPoint; 2], BenchError> {
+    let one = |lookahead| -> Result<FloorPoint, BenchError> {
         let mut floor = Floor::new(n, eta, seed)?;
         // The draws get a stream of their own (the initial state used `seed`).
         let mut rng = Xoshiro256PlusPlus::seed_from_u64(seed ^ u64::from_be_bytes(*b"\0\0\0floor"));
@@ -389,7 +394,7 @@ pub fn measure_both(n: usize, eta: f64, warmup: u64, timed: u64, seed: u64) -> R
 }
 
 /// The floor: the faster of [`measure_both`]'s two loops.
-pub fn measure(n: usize, eta: f64, warmup: u64, timed: u64, seed: u64) -> Result<FloorPoint, String> {
+pub fn measure(n: usize, eta: f64, warmup: u64, timed: u64, seed: u64) -> Result<FloorPoint, BenchError> {
     let [a, b] = measure_both(n, eta, warmup, timed, seed)?;
     Ok(if b.seconds < a.seconds { b } else { a })
 }

@@ -1,12 +1,17 @@
 //! The run configuration (TOML): parsing, defaults, validation.
 //!
-//! Unknown keys are errors (they are usually typos), in every table. Every validation error
-//! names the file, the field (or the line and column of a syntax error) and the value —
-//! cut short when it is long ([`crate::io::text`]) — and says what is allowed.
+//! Unknown keys are errors (they are usually typos), in every table. Every error is a
+//! [`ConfigError`] naming the file and the field (or the line and column of a syntax error),
+//! the value — cut short when it is long ([`crate::text`]) — and what is allowed. The keys,
+//! their defaults and their ranges are specified in `docs/configuration.md`.
+//!
+//! A configuration is validated for a dimension ([`Config::check_for`]): the box's entries
+//! and the close-packing limit depend on it.
 
 use crate::engine::Boundary;
 use crate::engine::init::{Placement, Species, Velocities};
-use crate::io::text::{line_column, num, shorten};
+use crate::observe::Selection;
+use crate::text::{line_column, num, shorten};
 use serde::{Deserialize, Serialize};
 use std::fmt;
 use std::path::Path;
@@ -60,6 +65,9 @@ pub struct Config {
     /// Optional outputs.
     #[serde(default)]
     pub output: OutputConfig,
+    /// Observables measured besides the thermodynamics (`[observe.<name>]`).
+    #[serde(default, skip_serializing_if = "Selection::is_empty")]
+    pub observe: Selection,
 }
 
 /// Boundaries: one for all axes, or one per axis.
@@ -82,7 +90,7 @@ impl<'de> Deserialize<'de> for Boundaries {
                 "wall" => Ok(Boundary::Wall),
                 other => Err(E::custom(format!(
                     "box.boundary: \"{}\" is not a boundary; expected {ALLOWED}",
-                    crate::io::text::excerpt(other)
+                    crate::text::excerpt(other)
                 ))),
             }
         }
@@ -186,18 +194,147 @@ pub struct OutputConfig {
     pub checkpoint_every: Option<u64>,
 }
 
-/// A configuration that could not be used.
+/// A value a configuration may not hold: the field, what it holds, and what is allowed.
+#[non_exhaustive]
 #[derive(Clone, Debug, PartialEq)]
-pub struct ConfigError {
-    /// Where it came from (a path, or "the embedded default").
-    pub source: String,
-    /// What is wrong.
-    pub message: String,
+pub enum Invalid {
+    /// A value outside what is allowed: `{field} = {value}: {allowed}`.
+    Value {
+        /// The field (`species[1].radius`).
+        field: String,
+        /// Its value, as written in messages.
+        value: String,
+        /// What is allowed.
+        allowed: String,
+    },
+    /// A list with the wrong number of entries: `{field} has {entries} entries: {allowed}`.
+    Entries {
+        /// The field.
+        field: String,
+        /// How many it has.
+        entries: usize,
+        /// What is allowed.
+        allowed: String,
+    },
+    /// A value given where another key decides: `{field} = {value} is used only with
+    /// {with}; {allowed}`.
+    OnlyWith {
+        /// The field.
+        field: String,
+        /// Its value.
+        value: String,
+        /// The key it goes with.
+        with: String,
+        /// What to do.
+        allowed: String,
+    },
+    /// Keys that do not go together, or one that is missing: `{field}: {allowed}`.
+    Fields {
+        /// The table or field.
+        field: String,
+        /// What is allowed.
+        allowed: String,
+    },
+}
+
+impl Invalid {
+    fn value(field: impl Into<String>, value: impl Into<String>, allowed: impl Into<String>) -> Invalid {
+        Invalid::Value { field: field.into(), value: value.into(), allowed: allowed.into() }
+    }
+
+    fn fields(field: impl Into<String>, allowed: impl Into<String>) -> Invalid {
+        Invalid::Fields { field: field.into(), allowed: allowed.into() }
+    }
+
+    /// The field it names.
+    pub fn field(&self) -> &str {
+        match self {
+            Invalid::Value { field, .. }
+            | Invalid::Entries { field, .. }
+            | Invalid::OnlyWith { field, .. }
+            | Invalid::Fields { field, .. } => field,
+        }
+    }
+}
+
+impl fmt::Display for Invalid {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self {
+            Invalid::Value { field, value, allowed } => write!(f, "{field} = {value}: {allowed}"),
+            Invalid::Entries { field, entries, allowed } => write!(f, "{field} has {entries} entries: {allowed}"),
+            Invalid::OnlyWith { field, value, with, allowed } => {
+                write!(f, "{field} = {value} is used only with {with}; {allowed}")
+            }
+            Invalid::Fields { field, allowed } => write!(f, "{field}: {allowed}"),
+        }
+    }
+}
+
+impl std::error::Error for Invalid {}
+
+/// A configuration that could not be used; every variant names where it came from (a path,
+/// or "the embedded default").
+#[non_exhaustive]
+#[derive(Clone, Debug, PartialEq)]
+pub enum ConfigError {
+    /// The file could not be read.
+    Read {
+        /// The file.
+        source: String,
+        /// What the system said.
+        reason: String,
+    },
+    /// A file too large to be a configuration.
+    TooLarge {
+        /// The file.
+        source: String,
+        /// Its size.
+        bytes: u64,
+    },
+    /// Not UTF-8.
+    NotUtf8 {
+        /// The file.
+        source: String,
+        /// Where the first bad byte is (1-based).
+        line: usize,
+        /// Its column (1-based).
+        column: usize,
+    },
+    /// Not TOML, or not this layout (an unknown key, a wrong type, an unknown name).
+    Syntax {
+        /// The file.
+        source: String,
+        /// Line and column, when known (1-based).
+        at: Option<(usize, usize)>,
+        /// What the parser said.
+        message: String,
+    },
+    /// A value that is not allowed.
+    Invalid {
+        /// The file.
+        source: String,
+        /// What is wrong.
+        invalid: Invalid,
+    },
 }
 
 impl fmt::Display for ConfigError {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        write!(f, "{}: {}", self.source, self.message)
+        let text = match self {
+            ConfigError::Read { source, reason } => format!("{source}: cannot read the file: {reason}"),
+            ConfigError::TooLarge { source, bytes } => format!(
+                "{source}: the file holds {bytes} bytes, more than a configuration can ({MAX_FILE_BYTES}); is it the right file?"
+            ),
+            ConfigError::NotUtf8 { source, line, column } => {
+                format!("{source}: line {line}, column {column}: not valid UTF-8 (TOML files are UTF-8 text)")
+            }
+            ConfigError::Syntax { source, at: Some((line, column)), message } => {
+                format!("{source}: TOML parse error at line {line}, column {column}: {message}")
+            }
+            ConfigError::Syntax { source, at: None, message } => format!("{source}: TOML parse error: {message}"),
+            ConfigError::Invalid { source, invalid } => format!("{source}: {invalid}"),
+        };
+        f.write_str(&shorten(&text))
     }
 }
 
@@ -206,36 +343,40 @@ impl std::error::Error for ConfigError {}
 /// The largest configuration file read (a configuration is a few hundred bytes).
 pub const MAX_FILE_BYTES: u64 = 1 << 24;
 
+/// Close packing in `d` dimensions: π/(2√3) for disks (the triangular lattice), π/√18 for
+/// spheres (fcc and hcp; Hales 2005). A packing fraction must lie below it.
+pub fn close_packing(d: usize) -> (f64, &'static str) {
+    match d {
+        2 => (0.9069, "π/(2√3)"),
+        _ => (0.7405, "π/√18"),
+    }
+}
+
 impl Config {
-    /// Parses and validates TOML text; `source` names it in errors. A syntax error or an
-    /// unknown key is reported with its line and column.
+    /// Parses and validates TOML text for a 2D run; `source` names it in errors. A syntax
+    /// error or an unknown key is reported with its line and column.
     pub fn parse(text: &str, source: &str) -> Result<Config, ConfigError> {
-        let err = |message: String| ConfigError { source: source.to_string(), message: shorten(&message) };
-        let config: Config = toml::from_str(text).map_err(|e| {
-            let at = e.span().map(|span| line_column(text, span.start));
-            err(match at {
-                Some((line, column)) => format!("TOML parse error at line {line}, column {column}: {}", e.message()),
-                None => format!("TOML parse error: {}", e.message()),
-            })
+        let config: Config = toml::from_str(text).map_err(|e| ConfigError::Syntax {
+            source: source.to_string(),
+            at: e.span().map(|span| line_column(text, span.start)),
+            message: e.message().to_string(),
         })?;
-        config.check().map_err(err)?;
+        config.check().map_err(|invalid| ConfigError::Invalid { source: source.to_string(), invalid })?;
         Ok(config)
     }
 
     /// Reads, parses and validates a file.
     pub fn load(path: &Path) -> Result<Config, ConfigError> {
         let source = path.display().to_string();
-        let fail = |message: String| ConfigError { source: source.clone(), message };
-        let size = std::fs::metadata(path).map_err(|e| fail(format!("cannot read the file: {e}")))?.len();
-        if size > MAX_FILE_BYTES {
-            return Err(fail(format!(
-                "the file holds {size} bytes, more than a configuration can ({MAX_FILE_BYTES}); is it the right file?"
-            )));
+        let unreadable = |e: std::io::Error| ConfigError::Read { source: source.clone(), reason: e.to_string() };
+        let bytes = std::fs::metadata(path).map_err(unreadable)?.len();
+        if bytes > MAX_FILE_BYTES {
+            return Err(ConfigError::TooLarge { source, bytes });
         }
-        let bytes = std::fs::read(path).map_err(|e| fail(format!("cannot read the file: {e}")))?;
+        let bytes = std::fs::read(path).map_err(unreadable)?;
         let text = String::from_utf8(bytes).map_err(|e| {
             let (line, column) = line_column(&String::from_utf8_lossy(e.as_bytes()), e.utf8_error().valid_up_to());
-            fail(format!("line {line}, column {column}: not valid UTF-8 (TOML files are UTF-8 text)"))
+            ConfigError::NotUtf8 { source: source.clone(), line, column }
         })?;
         Config::parse(&text, &source)
     }
@@ -245,11 +386,11 @@ impl Config {
         Config::parse(DEFAULT_CONFIG, "the embedded default").expect("the embedded default is valid")
     }
 
-    /// Boundaries per axis (2D).
-    pub fn boundaries(&self) -> [Boundary; 2] {
+    /// Boundaries per axis (the configuration has been checked for `D`).
+    pub fn boundaries<const D: usize>(&self) -> [Boundary; D] {
         match &self.sim_box.boundary {
-            Boundaries::All(b) => [*b; 2],
-            Boundaries::PerAxis(v) => [v[0], v[1]],
+            Boundaries::All(b) => [*b; D],
+            Boundaries::PerAxis(v) => std::array::from_fn(|a| v[a]),
         }
     }
 
@@ -259,38 +400,53 @@ impl Config {
         self.species.iter().fold(0usize, |n, s| n.saturating_add(s.count))
     }
 
-    /// Validates every value, as [`parse`](Self::parse) does: a configuration built or
-    /// edited in memory, or carried by a checkpoint, is checked exactly like a file.
-    pub fn check(&self) -> Result<(), String> {
+    /// [`check_for`](Self::check_for) two dimensions, as [`parse`](Self::parse) does.
+    pub fn check(&self) -> Result<(), Invalid> {
+        self.check_for(2)
+    }
+
+    /// Validates every value for a run in `d` dimensions: a configuration built or edited in
+    /// memory, or carried by a checkpoint, is checked exactly like a file.
+    pub fn check_for(&self, d: usize) -> Result<(), Invalid> {
         let positive = |name: &str, x: f64| {
             if x.is_finite() && x > 0.0 {
                 Ok(())
             } else {
-                Err(format!("{name} = {}: must be a positive finite number", num(x)))
+                Err(Invalid::value(name, num(x), "must be a positive finite number"))
             }
         };
+        let lengths = ["Lx", "Ly", "Lz"][..d.min(3)].join(", ");
         if let Boundaries::PerAxis(v) = &self.sim_box.boundary
-            && v.len() != 2
+            && v.len() != d
         {
-            return Err(format!("box.boundary has {} entries: give one per axis (2) or a single string", v.len()));
+            return Err(Invalid::Entries {
+                field: "box.boundary".into(),
+                entries: v.len(),
+                allowed: format!("give one per axis ({d}) or a single string"),
+            });
         }
         match (&self.sim_box.size, self.sim_box.packing_fraction) {
-            (Some(_), Some(_)) => return Err("box: give either size or packing_fraction, not both".into()),
-            (None, None) => return Err("box: give size = [Lx, Ly] or packing_fraction".into()),
+            (Some(_), Some(_)) => return Err(Invalid::fields("box", "give either size or packing_fraction, not both")),
+            (None, None) => return Err(Invalid::fields("box", format!("give size = [{lengths}] or packing_fraction"))),
             (Some(size), None) => {
-                if size.len() != 2 {
-                    return Err(format!("box.size has {} entries: give [Lx, Ly]", size.len()));
+                if size.len() != d {
+                    return Err(Invalid::Entries {
+                        field: "box.size".into(),
+                        entries: size.len(),
+                        allowed: format!("give [{lengths}]"),
+                    });
                 }
                 for (i, &l) in size.iter().enumerate() {
                     positive(&format!("box.size[{i}]"), l)?;
                 }
             }
             (None, Some(eta)) => {
-                // Close packing of equal disks: π/(2√3) ≈ 0.9069.
-                if !(eta.is_finite() && eta > 0.0 && eta < 0.9069) {
-                    return Err(format!(
-                        "box.packing_fraction = {}: must lie in (0, 0.9069) (close packing is π/(2√3))",
-                        num(eta)
+                let (limit, formula) = close_packing(d);
+                if !(eta.is_finite() && eta > 0.0 && eta < limit) {
+                    return Err(Invalid::value(
+                        "box.packing_fraction",
+                        num(eta),
+                        format!("must lie in (0, {limit}) (close packing is {formula})"),
                     ));
                 }
             }
@@ -298,49 +454,51 @@ impl Config {
         if let Some(aspect) = self.sim_box.aspect {
             positive("box.aspect", aspect)?;
             if self.sim_box.size.is_some() {
-                return Err(format!(
-                    "box.aspect = {} is used only with packing_fraction; with size = [Lx, Ly] the aspect is Ly/Lx (remove one of them)",
-                    num(aspect)
-                ));
+                return Err(Invalid::OnlyWith {
+                    field: "box.aspect".into(),
+                    value: num(aspect),
+                    with: "packing_fraction".into(),
+                    allowed: format!("with size = [{lengths}] the aspect is Ly/Lx (remove one of them)"),
+                });
             }
         }
         if self.species.is_empty() {
-            return Err("species: give at least one [[species]] with count, radius and mass".into());
+            return Err(Invalid::fields("species", "give at least one [[species]] with count, radius and mass"));
         }
         for (k, s) in self.species.iter().enumerate() {
             if s.count == 0 {
-                return Err(format!("species[{k}].count = 0: must be at least 1"));
+                return Err(Invalid::value(format!("species[{k}].count"), "0", "must be at least 1"));
             }
             positive(&format!("species[{k}].radius"), s.radius)?;
             positive(&format!("species[{k}].mass"), s.mass)?;
         }
         if self.species.iter().try_fold(0usize, |n, s| n.checked_add(s.count)).is_none() {
-            return Err("species: the counts add up to more than 2⁶⁴ particles".into());
+            return Err(Invalid::fields("species", "the counts add up to more than 2⁶⁴ particles"));
         }
         positive("init.kT", self.init.kt)?;
         for (k, s) in self.species.iter().enumerate() {
             // The thermal speed √(2kT/m) must be a number, and so must the total energy ~N·kT.
             let speed2 = 2.0 * self.init.kt / s.mass;
             if !(speed2.is_finite() && speed2 > 0.0) {
-                return Err(format!(
-                    "init.kT = {} with species[{k}].mass = {}: the thermal speed √(2kT/m) is out of the f64 range",
-                    num(self.init.kt),
-                    num(s.mass)
+                return Err(Invalid::value(
+                    "init.kT",
+                    format!("{} with species[{k}].mass = {}", num(self.init.kt), num(s.mass)),
+                    "the thermal speed √(2kT/m) is out of the f64 range",
                 ));
             }
         }
         if !(self.init.kt * self.n_particles() as f64).is_finite() {
-            return Err(format!(
-                "init.kT = {} with {} particles: the total kinetic energy overflows",
-                num(self.init.kt),
-                self.n_particles()
+            return Err(Invalid::value(
+                "init.kT",
+                format!("{} with {} particles", num(self.init.kt), self.n_particles()),
+                "the total kinetic energy overflows",
             ));
         }
         if self.run.collisions.is_none() && self.run.time.is_none() {
-            return Err("run: give collisions and/or time (the run stops at whichever comes first)".into());
+            return Err(Invalid::fields("run", "give collisions and/or time (the run stops at whichever comes first)"));
         }
         if self.run.collisions == Some(0) {
-            return Err("run.collisions = 0: must be at least 1".into());
+            return Err(Invalid::value("run.collisions", "0", "must be at least 1"));
         }
         if let Some(t) = self.run.time {
             positive("run.time", t)?;
@@ -348,21 +506,29 @@ impl Config {
         if let Some(t) = self.equilibration.time
             && !(t.is_finite() && t >= 0.0)
         {
-            return Err(format!("equilibration.time = {}: must be a finite number ≥ 0", num(t)));
+            return Err(Invalid::value("equilibration.time", num(t), "must be a finite number ≥ 0"));
         }
         // How many samples that makes is checked with the other limits of a run
         // (`run::limits`), which also estimate it when the run is given in collisions.
         positive("run.sample_interval", self.run.sample_interval)?;
         if self.run.blocks < 2 {
-            return Err(format!("run.blocks = {}: must be at least 2 (error bars need two blocks)", self.run.blocks));
+            return Err(Invalid::value(
+                "run.blocks",
+                self.run.blocks.to_string(),
+                "must be at least 2 (error bars need two blocks)",
+            ));
         }
         for (name, every) in
             [("trajectory_every", self.output.trajectory_every), ("checkpoint_every", self.output.checkpoint_every)]
         {
             if every == Some(0) {
-                return Err(format!(
-                    "output.{name} = 0: must be at least 1 (leave it out for {})",
-                    if name == "trajectory_every" { "no trajectory" } else { "only the final checkpoint" }
+                return Err(Invalid::value(
+                    format!("output.{name}"),
+                    "0",
+                    format!(
+                        "must be at least 1 (leave it out for {})",
+                        if name == "trajectory_every" { "no trajectory" } else { "only the final checkpoint" }
+                    ),
                 ));
             }
         }
@@ -378,7 +544,7 @@ mod tests {
     fn default_parses() {
         let c = Config::default_config();
         assert_eq!(c.n_particles(), 1000);
-        assert_eq!(c.boundaries(), [Boundary::Periodic; 2]);
+        assert_eq!(c.boundaries::<2>(), [Boundary::Periodic; 2]);
     }
 
     fn error_of(edit: &str, with: &str) -> String {

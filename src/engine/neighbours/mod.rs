@@ -20,7 +20,7 @@
 //! computed as the exact negative from either side (`cⱼ − cᵢ = −(cᵢ − cⱼ)` in floating
 //! point, and the image count is `round(d/L)`, odd in `d`), so both sides agree.
 //!
-//! A list holds at most [`CAPACITY`] neighbours in one 32-byte block (a contiguous row, read
+//! A list holds at most [`CAPACITY`](lists::CAPACITY) neighbours in one 32-byte block (a contiguous row, read
 //! by the batch kernel eight lanes at a time). A particle with more is *crowded*: it keeps
 //! no list and searches the cell grid around its centre instead, which holds everyone in
 //! range (cells are `R` wide); it gets a list again at its next rebuild if the neighbours
@@ -31,96 +31,16 @@
 //! With lists, the cell grid ([`Cells`]) holds each particle by its centre, so a particle
 //! changes cell only when it rebuilds, with no crossing events.
 
-use super::cells::{Around, Cells, Coord};
-use super::geometry::{Boundary, Particle, SimBox};
-use super::pages;
-use super::prefetch::prefetch;
+pub(crate) mod cells;
+pub(crate) mod lists;
+
+use crate::engine::geometry::{Boundary, Particle, SimBox};
+use crate::engine::motion;
+use cells::{Cells, Coord};
+pub use lists::{LISTS_FROM, RANGE_HOLDS};
+use lists::{List, NONE, skin_for};
 use nalgebra::SVector;
 use serde::{Deserialize, Serialize};
-
-/// The most neighbours a list holds (a crowded particle searches the grid).
-pub const CAPACITY: usize = 8;
-
-/// An unused entry (lists are packed at the front).
-const NONE: u32 = u32::MAX;
-
-/// The first entry of a crowded particle's list.
-const CROWDED: u32 = u32::MAX - 1;
-
-/// One particle's neighbours, `NONE` after the last; `[CROWDED, ..]` for a crowded particle.
-#[derive(Clone, Copy, Debug)]
-#[repr(C, align(32))]
-struct List([u32; CAPACITY]);
-
-impl List {
-    const EMPTY: List = List([NONE; CAPACITY]);
-    const CROWDED: List = {
-        let mut list = List::EMPTY;
-        list.0[0] = CROWDED;
-        list
-    };
-
-    fn crowded(&self) -> bool {
-        self.0[0] == CROWDED
-    }
-
-    /// Takes `i` out, moving the last entry into its place (no-op if crowded or absent).
-    fn drop(&mut self, i: u32) {
-        if self.crowded() {
-            return;
-        }
-        // Members first, then `NONE`s: count the members and find `i` without branches.
-        let (mut len, mut at) = (0, CAPACITY);
-        for (k, &j) in self.0.iter().enumerate() {
-            len += (j != NONE) as usize;
-            at = if j == i { k } else { at };
-        }
-        if at < CAPACITY {
-            self.0[at] = self.0[len - 1];
-            self.0[len - 1] = NONE;
-        }
-    }
-
-    /// Puts `i` in; a full list becomes crowded.
-    fn add(&mut self, i: u32) {
-        if self.crowded() {
-            return;
-        }
-        let len = self.0.iter().filter(|&&j| j != NONE).count();
-        match len {
-            CAPACITY => *self = List::CROWDED,
-            _ => self.0[len] = i,
-        }
-    }
-
-    fn from_members(members: &[u32]) -> List {
-        if members.len() > CAPACITY {
-            return List::CROWDED;
-        }
-        let mut list = List::EMPTY;
-        list.0[..members.len()].copy_from_slice(members);
-        list
-    }
-}
-
-/// Lists are kept (by [`Neighbourhood::Auto`]) from this packing fraction on,
-/// `n·π(reach/2)²` with `n` the number density, at every N. Measured with the rebuild of
-/// the sixth session (alternating runs, `--neighbourhood grid` and `lists`, medians of 4,
-/// 10⁶ collisions/s, lists against the grid): at η = 0.65, 2.04 vs 1.94 at N = 10³, 1.90 vs
-/// 1.74 at 3·10³, 1.99 vs 1.87 at 10⁴, 1.32 vs 1.32 at 3·10⁴ (and 1.02 vs 0.93 at 10⁵, 0.88
-/// vs 0.64 at 10⁶ in the fifth session); at N = 10⁴, 2.04 vs 1.72 at η = 0.7, 1.74 vs 1.65
-/// at 0.64, 1.37 vs 1.44 at 0.62, 1.65 vs 1.75 at 0.6 and 1.36 vs 1.64 at 0.5. Lists save
-/// the walk through the cell lists (and, at large N, most of the cache misses around a
-/// collision); at lower densities a particle leaves its skin so often that the rebuilds cost
-/// more.
-pub const LISTS_FROM: f64 = 0.63;
-
-/// The mean number of particles the list range is sized to hold, `n·πR²`. Measured at
-/// η = 0.65, N = 10⁴ (skin as a fraction of the contact distance: collisions/s, rebuilds
-/// per collision, crowded particles): 0.25: 0.93·10⁶, 0.76, 0 %; 0.6: 1.48·10⁶, 0.20, 0 %;
-/// 0.8 (which this gives): 1.59·10⁶, 0.12, 5 %; 1.0 at N = 10⁵: 41 % crowded and 25 %
-/// slower than 0.8.
-pub const RANGE_HOLDS: f64 = 8.4;
 
 /// How [`Simulation`](super::Simulation) finds the particles that can touch one another.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
@@ -178,38 +98,6 @@ impl std::str::FromStr for Neighbourhood {
             .find(|n| n.name() == s)
             .ok_or_else(|| UnknownNeighbourhood(s.to_string()))
     }
-}
-
-/// The skin for lists, or `None` for the grid that follows the particles: lists only in 2D
-/// (in 3D a list of [`CAPACITY`] holds fewer than a dense fluid's neighbours), with no short
-/// periodic axis (`allow`), and for [`Neighbourhood::Auto`] from [`LISTS_FROM`] on. The skin makes the range hold [`RANGE_HOLDS`] particles, within
-/// `[reach/4, reach]`, and short enough that a range plus a skin stays under half of every
-/// periodic box length (one image of a pair in range).
-fn skin_for<const D: usize>(
-    sim_box: &SimBox<D>,
-    reach: f64,
-    n: usize,
-    allow: bool,
-    choice: Neighbourhood,
-) -> Option<f64> {
-    let density = n as f64 / sim_box.volume();
-    let eta = density * std::f64::consts::PI * 0.25 * reach * reach;
-    let wanted = match choice {
-        Neighbourhood::Auto => eta >= LISTS_FROM,
-        Neighbourhood::Grid => false,
-        Neighbourhood::Lists => true,
-    };
-    if D != 2 || !allow || !wanted {
-        return None;
-    }
-    let range = (RANGE_HOLDS / (std::f64::consts::PI * density)).sqrt();
-    let mut skin = (range - reach).clamp(0.25 * reach, reach);
-    for a in 0..D {
-        if sim_box.boundary[a] == Boundary::Periodic {
-            skin = skin.min(0.45 * (0.5 * sim_box.lengths[a] - reach));
-        }
-    }
-    Some(skin)
 }
 
 /// The centres, the lists and the grid of centres — or the grid that follows the particles.
@@ -310,17 +198,18 @@ impl<const D: usize> Neighbours<D> {
                 }
                 let range = reach + skin;
                 let half = 0.5 * skin * (1.0 - f64::EPSILON * (1u64 << 32) as f64);
-                let centres = pages::moved(centres);
                 let mut neighbours = empty(Cells::new(sim_box, range, centres.iter().copied()));
                 neighbours.centres = centres;
                 neighbours.listed = true;
                 neighbours.range2 = range * range;
                 neighbours.exit2 = half * half;
                 neighbours.bound2 = 0.25 * skin * skin;
-                neighbours.lists = pages::collect((0..n).map(|i| {
-                    neighbours.scan(i);
-                    List::from_members(&neighbours.scratch)
-                }));
+                neighbours.lists = (0..n)
+                    .map(|i| {
+                        neighbours.scan(i);
+                        List::from_members(&neighbours.scratch)
+                    })
+                    .collect();
                 for &k in &crowded {
                     neighbours.lists[k as usize] = List::CROWDED;
                 }
@@ -377,9 +266,8 @@ impl<const D: usize> Neighbours<D> {
 
     /// The squared distance from centre `a` to the nearest image of centre `b`. The image
     /// count per periodic axis is `round(x/L)`, as `x·(1/L)` rounded half to even: one
-    /// instruction, where [`SimBox::minimum_image_shift`]'s comparisons and branches cost
-    /// about 60 instructions an axis, which made a rebuild's scan of some 24 centres cost
-    /// 3 200 (callgrind, N = 10⁴, η = 0.65). Which image wins where `x/L` is within an ulp of
+    /// instruction, where [`SimBox::minimum_image_shift`]'s comparisons and branches would
+    /// dominate a rebuild's scan of some two dozen centres. Which image wins where `x/L` is within an ulp of
     /// a half does not matter: the range is under half of every periodic length
     /// ([`skin_for`]). The same number from either side (the count is an odd function of
     /// `x`, and `x` negates exactly), which keeps the lists symmetric.
@@ -440,8 +328,8 @@ impl<const D: usize> Neighbours<D> {
                 }
             }
         } else {
-            for &j in list.0.iter().take_while(|&&j| j != NONE) {
-                self.lists[j as usize].drop(i as u32);
+            for j in list.members() {
+                self.lists[j].drop(i as u32);
             }
         }
         let centre = p.position_at(t);
@@ -465,9 +353,8 @@ impl<const D: usize> Neighbours<D> {
     /// Velocities are scaled first by the power of two that brings their largest component
     /// into `[1, 2)` (or as near as the exponent range allows), so that neither `|v|²` nor
     /// `d·v` overflows or underflows; a power of two, so that scaling and unscaling are exact
-    /// multiplications, not divisions — this chain of a square root and then divisions sits
-    /// at the head of every prediction (three divisions before, the stall at the head of the
-    /// prediction's samples in `perf`, N = 10⁴, η = 0.65). The time only has to be within
+    /// multiplications, not divisions (this chain of a square root and a division sits at
+    /// the head of every prediction, so every division saved shortens it). The time only has to be within
     /// the exit radius's margin of 2³² ulps of the skin, which some ulps of rounding are far
     /// from. `None` at rest, or never.
     #[inline]
@@ -487,7 +374,7 @@ impl<const D: usize> Neighbours<D> {
         let inverse = f64::from_bits(((2046 - biased) as u64) << 52);
         let (mut a, mut b, mut dd) = (0.0, 0.0, 0.0);
         for k in 0..D {
-            let d = (p.position[k] + p.velocity[k] * (now - p.time)) - c[k];
+            let d = motion::coordinate(p.position[k], p.velocity[k], now - p.time) - c[k];
             let u = p.velocity[k] * inverse;
             a += u * u;
             b += d * u;
@@ -498,8 +385,8 @@ impl<const D: usize> Neighbours<D> {
         let root = (b * b - a * c0).sqrt();
         // The larger root without cancellation, in whichever form the sign of `b` allows.
         // Moving toward or away from the centre is a coin toss for the branch predictor, and
-        // a miss here stalled on the square root (a tenth of the prediction's time in `perf`,
-        // N = 10⁴, η = 0.65): both forms are selected, then divided once.
+        // a miss here would stall behind the square root: both forms are selected, then
+        // divided once.
         let toward = b <= 0.0;
         let numerator = std::hint::select_unpredictable(toward, root - b, -c0);
         let denominator = std::hint::select_unpredictable(toward, a, b + root);
@@ -535,7 +422,7 @@ impl<const D: usize> Neighbours<D> {
             return self.cells.gather(&self.cell(i), i, skip, out);
         };
         let mut len = 0;
-        for (k, &j) in list.0.iter().enumerate() {
+        for (k, &j) in list.entries().iter().enumerate() {
             out[len.min(k)] = j;
             len += ((j != NONE) & (j as usize != skip)) as usize;
         }
@@ -547,71 +434,33 @@ impl<const D: usize> Neighbours<D> {
     /// batch search sees through [`gather`](Self::gather).
     pub fn candidates(&self, i: usize) -> impl Iterator<Item = usize> + '_ {
         let list = self.lists.get(i).filter(|list| !list.crowded());
-        let listed = list.into_iter().flat_map(|list| list.0.iter().take_while(|&&j| j != NONE).map(|&j| j as usize));
+        let listed = list.into_iter().flat_map(List::members);
         let grid = list.is_none().then(|| self.cells.neighbours(self.cell(i))).into_iter().flatten();
         listed.chain(grid)
     }
 
-    /// The lookahead's first stage for particle `i`: its list and centre, or its cell
-    /// coordinates.
+    /// The cell grid (of centres with lists; following the particles without).
     #[inline]
-    pub fn prefetch_first(&self, i: usize) {
-        if self.listed {
-            prefetch(&self.lists[i]);
-            prefetch(&self.centres[i]);
-        } else {
-            self.cells.prefetch_coord(i);
-        }
+    pub(crate) fn cells(&self) -> &Cells<D> {
+        &self.cells
     }
 
-    /// The second stage (the first should have arrived): the records (from `records`, one
-    /// per particle) on `i`'s list, or the heads of the cells around it.
+    /// Particle `i`'s list row, with lists.
     #[inline]
-    pub fn prefetch_second<T>(&self, i: usize, records: &[T]) {
-        if !self.listed {
-            self.cells.prefetch_heads(&self.cells.around(&self.cells.wrapped(i)));
-        } else if !self.lists[i].crowded() {
-            for &j in self.lists[i].0.iter().take_while(|&&j| j != NONE) {
-                prefetch(&records[j as usize]);
-            }
-        }
+    pub(crate) fn row(&self, i: usize) -> Option<&List> {
+        self.lists.get(i)
     }
 
-    /// The second stage for a particle `i` whose next event is leaving its skin, at `centre`
-    /// (with lists): the rows of its old neighbours (which it leaves) and the heads of the
-    /// cells around its new centre (which [`rebuild`](Self::rebuild) scans). Returns those
-    /// cells, for [`prefetch_rebuild_third`](Self::prefetch_rebuild_third); `None` without
-    /// lists.
+    /// The list centres (empty without lists).
     #[inline]
-    pub fn prefetch_rebuild_second(&self, i: usize, centre: &SVector<f64, D>) -> Option<Around> {
-        if !self.listed {
-            return None;
-        }
-        let list = &self.lists[i];
-        if !list.crowded() {
-            for &j in list.0.iter().take_while(|&&j| j != NONE) {
-                prefetch(&self.lists[j as usize]);
-            }
-        }
-        let around = self.cells.around(&self.cells.locate(centre));
-        self.cells.prefetch_heads(&around);
-        Some(around)
+    pub(crate) fn centres(&self) -> &[SVector<f64, D>] {
+        &self.centres
     }
 
-    /// The third stage of [`prefetch_rebuild_second`](Self::prefetch_rebuild_second): the
-    /// first member of each of those cells, its link and its centre.
-    #[inline]
-    pub fn prefetch_rebuild_third(&self, around: &Around) {
-        self.cells.prefetch_members(around, &self.centres);
-    }
-
-    /// The third stage, for the grid (the heads should have arrived): the first member of
-    /// each cell around `i`, and its link.
-    #[inline]
-    pub fn prefetch_third<T>(&self, i: usize, records: &[T]) {
-        if !self.listed {
-            self.cells.prefetch_members(&self.cells.around(&self.cells.wrapped(i)), records);
-        }
+    /// The large arrays, for the timing room (which may move them into huge pages; nothing
+    /// else about them changes).
+    pub(crate) fn large_arrays(&mut self) -> [&mut dyn crate::engine::timing::LargeArray; 3] {
+        [&mut self.centres, &mut self.lists, self.cells.links()]
     }
 
     /// Checks the lists against their definition: `j` is on `i`'s list exactly when their
@@ -622,7 +471,7 @@ impl<const D: usize> Neighbours<D> {
             if self.lists[i].crowded() {
                 continue;
             }
-            let mut listed: Vec<u32> = self.lists[i].0.iter().copied().take_while(|&j| j != NONE).collect();
+            let mut listed: Vec<u32> = self.lists[i].members().map(|j| j as u32).collect();
             listed.sort_unstable();
             let mut expected: Vec<u32> =
                 (0..self.centres.len()).filter(|&j| j != i && self.within(i, j)).map(|j| j as u32).collect();

@@ -8,7 +8,7 @@
 //!   `{"id": <same>, "t": <num or null>}` (`null` = never, `0` = now).
 //!
 //! `<num>` is a JSON number or a string holding a decimal or hex float, read exactly
-//! ([`crate::io::numbers`]). An output number beyond the f64 range (a root or a time that
+//! ([`super::numbers`]). An output number beyond the f64 range (a root or a time that
 //! overflows) is the string `"inf"` (or `"-inf"`): JSON has no infinity, and every line
 //! out is strict JSON. `id` is echoed verbatim, as its source text (`null` if absent).
 //!
@@ -18,7 +18,7 @@
 //! number; every other line is still answered. Blank lines are skipped.
 
 use super::numbers::{NumberFormat, format_json, parse_json};
-use super::text::shorten;
+use crate::text::shorten;
 use quadratic::{Ball, Roots};
 use serde_json::Value;
 use serde_json::value::RawValue;
@@ -197,7 +197,7 @@ fn answer_contact(fields: &Fields, format: NumberFormat) -> Result<String, Strin
         DynBall { position: vector(fields, "r1")?, velocity: vector(fields, "v1")?, radius: number(fields, "R1")? };
     let second =
         DynBall { position: vector(fields, "r2")?, velocity: vector(fields, "v2")?, radius: number(fields, "R2")? };
-    let time = contact_time_dyn(&first, &second)?;
+    let time = contact_time_dyn(&first, &second).map_err(|e| e.to_string())?;
     let t = time.map_or_else(|| "null".to_string(), |t| format_json(t, format));
     Ok(format!("{{\"id\":{},\"t\":{t}}}", id_text(fields)))
 }
@@ -213,13 +213,51 @@ pub struct DynBall {
     pub radius: f64,
 }
 
+/// Why two balls given at run time have no contact time.
+#[non_exhaustive]
+#[derive(Clone, Debug, PartialEq)]
+pub enum QueryError {
+    /// A vector with another number of components than `r1`'s.
+    Components {
+        /// The vector (`v1`, `r2` or `v2`).
+        field: &'static str,
+        /// Its components.
+        found: usize,
+        /// `r1`'s.
+        expected: usize,
+    },
+    /// Neither 2 nor 3 components.
+    Dimension {
+        /// `r1`'s components.
+        found: usize,
+    },
+    /// The kernel refused the balls (a negative or non-finite radius, a non-finite coordinate).
+    Contact(quadratic::ContactError),
+}
+
+impl std::fmt::Display for QueryError {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            QueryError::Components { field, found, expected } => {
+                write!(f, "{field} has {found} components but r1 has {expected}; all vectors need the same")
+            }
+            QueryError::Dimension { found } => {
+                write!(f, "vectors must have 2 (disks) or 3 (spheres) components, r1 has {found}")
+            }
+            QueryError::Contact(e) => write!(f, "{e}"),
+        }
+    }
+}
+
+impl std::error::Error for QueryError {}
+
 /// The contact time of two balls given at run time: 2 or 3 components, all the same length.
 /// `Ok(None)` is "never"; `Ok(Some(0.0))` is "now".
-pub fn contact_time_dyn(first: &DynBall, second: &DynBall) -> Result<Option<f64>, String> {
+pub fn contact_time_dyn(first: &DynBall, second: &DynBall) -> Result<Option<f64>, QueryError> {
     let d = first.position.len();
-    for (name, v) in [("v1", &first.velocity), ("r2", &second.position), ("v2", &second.velocity)] {
+    for (field, v) in [("v1", &first.velocity), ("r2", &second.position), ("v2", &second.velocity)] {
         if v.len() != d {
-            return Err(format!("{name} has {} components but r1 has {d}; all vectors need the same", v.len()));
+            return Err(QueryError::Components { field, found: v.len(), expected: d });
         }
     }
     fn fixed<const D: usize>(b: &DynBall) -> Ball<D> {
@@ -229,9 +267,9 @@ pub fn contact_time_dyn(first: &DynBall, second: &DynBall) -> Result<Option<f64>
     let contact = match d {
         2 => quadratic::contact_time(&fixed::<2>(first), &fixed::<2>(second)),
         3 => quadratic::contact_time(&fixed::<3>(first), &fixed::<3>(second)),
-        _ => return Err(format!("vectors must have 2 (disks) or 3 (spheres) components, r1 has {d}")),
+        _ => return Err(QueryError::Dimension { found: d }),
     };
-    contact.map(|c| c.time()).map_err(|e| e.to_string())
+    contact.map(|c| c.time()).map_err(QueryError::Contact)
 }
 
 #[cfg(test)]

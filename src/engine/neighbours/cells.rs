@@ -1,4 +1,4 @@
-//! The cell grid, in one of two roles (see [`Neighbours`](super::neighbours::Neighbours)):
+//! The cell grid, in one of two roles (see [`Neighbours`](super::Neighbours)):
 //!
 //! * **Following** the particles ([`Cells::follow`]): cells at least one contact distance
 //!   wide, each particle in the cell of its current position, so that every possible partner
@@ -11,8 +11,8 @@
 //!   each particle in the cell of its centre, which moves only when the particle leaves its
 //!   skin. No coordinate is stored: [`Cells::locate`] finds it from the centre.
 
-use super::geometry::{Boundary, SimBox};
-use super::pages;
+use crate::engine::geometry::{Boundary, SimBox};
+use crate::engine::motion;
 use nalgebra::SVector;
 
 /// No particle / end of a cell list.
@@ -23,8 +23,8 @@ pub type Coord<const D: usize> = [u32; D];
 
 /// Cell lists over the box, as intrusive singly linked lists: one head per cell and a `next`
 /// link per particle. Nothing allocates after construction, and the grid costs 4 bytes per
-/// particle plus 4 per cell — where a `Vec` per cell cost 24 bytes of header per cell and a
-/// heap block each (measured: 420–570 bytes per particle for the whole engine before).
+/// particle plus 4 per cell (a `Vec` per cell would cost 24 bytes of header per cell and a
+/// heap block each).
 /// Removing a particle walks its cell's list, which holds about one particle, so a back
 /// link would cost more memory than it saves time. Which cell a particle is in is not
 /// stored: the caller locates it from the particle's centre (the same function of the same
@@ -44,8 +44,8 @@ pub struct Cells<const D: usize> {
     /// Following: the unwrapped cell coordinate of each particle (else empty).
     coords: Vec<[i64; D]>,
     /// Following: the same, wrapped into the grid (`coords` modulo `counts`; else empty). The
-    /// cells around a particle are then found without a division (two per call cost more
-    /// than the rest of [`Cells::gather`]'s cell arithmetic; 8 bytes per particle in 2D).
+    /// cells around a particle are then found without a division (a division per axis would
+    /// cost more than the rest of [`Cells::gather`]'s cell arithmetic).
     wrapped: Vec<Coord<D>>,
 }
 
@@ -172,7 +172,7 @@ impl<const D: usize> Cells<D> {
 
     fn with_coords(mut self, mut coords: Vec<[i64; D]>) -> Self {
         coords.shrink_to_fit();
-        self.next = pages::filled(coords.len() + 1, NONE);
+        self.next = vec![NONE; coords.len() + 1];
         self.wrapped = coords.iter().map(|m| self.wrap_axes(m)).collect();
         self.coords = coords;
         for i in 0..self.coords.len() {
@@ -246,7 +246,7 @@ impl<const D: usize> Cells<D> {
                 continue;
             }
             let edge = (m[a] + up as i64) as f64 * self.widths[a];
-            let dt = ((edge - x[a]) / v[a]).max(0.0);
+            let dt = motion::time_to(x[a], v[a], edge).max(0.0);
             // The first axis, or an earlier crossing than the best so far (ties: lower axis).
             let better = dt < best_dt || best_axis == usize::MAX;
             best_dt = best_dt.min(dt);
@@ -322,10 +322,9 @@ impl<const D: usize> Cells<D> {
     }
 
     /// The [`Stencil`] of cell `m`. Away from the walls every axis with three cells or more
-    /// gives m − 1, m, m + 1, wrapped by comparison (this and the unrolled loops replaced a
-    /// general construction that cost about 350 instructions a call; callgrind, N = 10⁴,
-    /// η = 0.65); next to a wall, or with fewer than three cells (which wrap onto each
-    /// other), the distinct ones are listed one by one.
+    /// gives m − 1, m, m + 1, wrapped by comparison, and the loops over them unroll; next to
+    /// a wall, or with fewer than three cells (which wrap onto each other), the distinct ones
+    /// are listed one by one.
     #[inline(always)]
     fn stencil(&self, w: &Coord<D>) -> Stencil {
         let mut s = Stencil { offsets: [[0; 3]; 3], lens: [1; 3], full: true };
@@ -355,32 +354,30 @@ impl<const D: usize> Cells<D> {
         s
     }
 
-    /// Following: prefetches particle `i`'s cell coordinates.
+    /// Following: where particle `i`'s cell coordinates are kept (the timing room asks, to
+    /// prefetch them).
     #[inline]
-    pub fn prefetch_coord(&self, i: usize) {
-        super::prefetch::prefetch(&self.coords[i]);
-        super::prefetch::prefetch(&self.wrapped[i]);
+    pub(crate) fn coord_refs(&self, i: usize) -> (&[i64; D], &Coord<D>) {
+        (&self.coords[i], &self.wrapped[i])
     }
 
-    /// Prefetches the heads of the cells `around` (from [`Cells::around`]).
+    /// The head of cell `c`'s list (a flat index from [`Cells::around`]).
     #[inline]
-    pub fn prefetch_heads(&self, around: &Around) {
-        for &c in around.as_slice() {
-            super::prefetch::prefetch(&self.head[c as usize]);
-        }
+    pub(crate) fn head(&self, c: u32) -> &u32 {
+        &self.head[c as usize]
     }
 
-    /// Prefetches the first member of each of the cells `around`, from `records` (one per
-    /// particle), and its link (the heads should already be in cache).
+    /// The links through the particles, for the timing room (which may move them into huge
+    /// pages).
+    pub(crate) fn links(&mut self) -> &mut dyn crate::engine::timing::LargeArray {
+        &mut self.next
+    }
+
+    /// The first particle in cell `c` and where its link is kept, if the cell holds one.
     #[inline]
-    pub fn prefetch_members<T>(&self, around: &Around, records: &[T]) {
-        for &c in around.as_slice() {
-            let j = self.head[c as usize];
-            if j != NONE {
-                super::prefetch::prefetch(&self.next[j as usize]);
-                super::prefetch::prefetch(&records[j as usize]);
-            }
-        }
+    pub(crate) fn first_member(&self, c: u32) -> Option<(usize, &u32)> {
+        let j = self.head[c as usize];
+        (j != NONE).then(|| (j as usize, &self.next[j as usize]))
     }
 
     /// The particles in cell `c` (a flat index from [`Cells::around`]).
@@ -394,8 +391,7 @@ impl<const D: usize> Cells<D> {
     ///
     /// The first two members of each cell are taken without branches: a cell one contact
     /// distance wide seldom holds more, and how many it holds is a coin toss for the branch
-    /// predictor (a loop per cell cost about 2 mispredictions per gather; callgrind's branch
-    /// simulation, N = 10⁴, η = 0.65). The end of a list, `NONE`, reads the sentinel link
+    /// predictor (a loop per cell mispredicts its exit). The end of a list, `NONE`, reads the sentinel link
     /// past the last particle, which is `NONE` again, and is not counted. Every write goes to
     /// `out[min(len, last)]`, with no early exit: once `len` reaches `out.len()` the entries
     /// are no longer trusted and the answer is `None`, but until then no write is clamped.
@@ -404,8 +400,8 @@ impl<const D: usize> Cells<D> {
         let sentinel = self.next.len() - 1;
         let last = out.len().checked_sub(1)?;
         let mut len = 0;
-        // The closure is inlined into each of the unrolled cells (a call per cell cost more
-        // than the members it gathers).
+        // The closure is inlined into each of the unrolled cells (a call per cell would cost
+        // more than the members it gathers).
         self.stencil(m).for_each::<D>(
             #[inline(always)]
             |c| {

@@ -1,0 +1,355 @@
+//! A particle's earliest pair collision among its neighbours, fast — the same answer, bit for
+//! bit, as evaluating [`pair::predict`] for every neighbour and taking the earliest in the
+//! total order (checked against that, and against the brute-force reference).
+//!
+//! Two passes. First every neighbour is *bracketed*: the certified f64 filter of the kernel
+//! ([`contact_brackets`]) gives an interval `[lo, hi]` holding the pair's contact time (or
+//! says there is none), [`LANES`] neighbours at a time, branch-free, without any
+//! double-double arithmetic; the bound becomes the smallest upper end (or the particle's
+//! earliest other event). Then only the *candidates* — the neighbours whose lower end
+//! reaches down to the bound, usually one — get their exact time: from the bracket itself
+//! when both ends round to the same absolute time (rounding is monotone, so that is the time
+//! to the bit), else pinned to one ulp ([`Lanes::pinned`]), else from the exact root. A lower
+//! end equal to the bound is kept: it may tie and win.
+//!
+//! Short periodic axes (several images of one pair) and crowds of more than [`NEAR`]
+//! neighbours take the scalar search, one pair at a time with a shrinking horizon; same
+//! events.
+
+use super::geometry::{Boundary, Particle, SimBox, image_count, image_count_by_comparison};
+use super::motion;
+use super::neighbours::Neighbours;
+use super::sources::pair::{self, PairBracket};
+use super::sources::{Event, EventKind};
+use quadratic::{BallLanes, contact_brackets, contact_time_unchecked, narrow_contact};
+
+/// Pairs bracketed at once: one AVX-512 register of f64 (two AVX2).
+pub const LANES: usize = 8;
+
+/// Neighbours gathered per prediction for the batch search (more: the scalar search).
+pub(crate) const NEAR: usize = 64;
+
+/// Brackets kept by the scalar search before it evaluates one exactly on the spot (a
+/// particle rarely has more than a handful of approaching neighbours).
+const HITS: usize = 32;
+
+/// The batch search's scratch space, kept so that no prediction spends time initialising a
+/// kilobyte of stack; and whether the batch is used at all.
+///
+/// Aligned to a cache line, each array at a multiple of 64 bytes: the lanes are read and
+/// written eight f64 at a time, and a vector that straddles two lines costs two accesses.
+#[derive(Clone, Debug)]
+#[repr(C, align(64))]
+pub(crate) struct Search<const D: usize> {
+    lo: [f64; NEAR],
+    hi: [f64; NEAR],
+    lanes: [Lanes<D>; NEAR / LANES],
+    /// Search with the batch kernel; false when an axis is short (several images per pair)
+    /// — and in the test that compares both searches.
+    pub(crate) batch: bool,
+}
+
+impl<const D: usize> Search<D> {
+    /// The search for a box with (`batch = false`) or without short periodic axes.
+    pub(crate) fn new(batch: bool) -> Self {
+        Search { batch, lo: [f64::INFINITY; NEAR], hi: [f64::INFINITY; NEAR], lanes: [Lanes::default(); NEAR / LANES] }
+    }
+
+    /// Particle `i`'s neighbours but `skip`, for the batch search: how many, or `None` when
+    /// the batch cannot take them (short axes, or more than [`NEAR`]).
+    #[inline]
+    pub(crate) fn gather(
+        &self,
+        neighbours: &Neighbours<D>,
+        i: usize,
+        skip: usize,
+        near: &mut [u32; NEAR],
+    ) -> Option<usize> {
+        if self.batch { neighbours.gather(i, skip, near) } else { None }
+    }
+
+    /// Offers particle `i`'s earliest pair event but with `skip` (the partner just resolved
+    /// with it: the partner's own prediction covers the pair) to `best`, no earlier than
+    /// `now`. `near[..n]` are its neighbours when [`gather`](Self::gather) took them
+    /// (`gathered = Some(n)`); `None`: the scalar search.
+    #[allow(clippy::too_many_arguments)]
+    #[inline(always)]
+    pub(crate) fn earliest(
+        &mut self,
+        particles: &[Particle<D>],
+        sim_box: &SimBox<D>,
+        short: &[bool; D],
+        neighbours: &Neighbours<D>,
+        now: f64,
+        i: usize,
+        skip: usize,
+        near: &[u32; NEAR],
+        gathered: Option<usize>,
+        best: &mut Event,
+    ) {
+        let owner = i as u32;
+        let consider = |best: &mut Event, e: Event| {
+            if e.before(owner, best, owner) {
+                *best = e;
+            }
+        };
+        let Some(n_near) = gathered else {
+            return scalar(particles, sim_box, short, neighbours, now, i, skip, best);
+        };
+        // Pass 1: bracket the neighbours LANES at a time (branch-free); `bound` is the
+        // earliest time some candidate is certain to reach. Every chunk is LANES wide (the
+        // lanes past the neighbours give [+∞, +∞]), so that no loop below ends at a count
+        // the branch predictor cannot know.
+        let lanes = n_near.div_ceil(LANES) * LANES;
+        let Search { lo, hi, lanes: balls, .. } = self;
+        let mut bound = best.time;
+        for start in (0..lanes).step_by(LANES) {
+            let chunk = start..start + LANES;
+            let js = near[chunk.clone()].try_into().expect("LANES wide");
+            let (lo, hi) = (&mut lo[chunk.clone()], &mut hi[chunk]);
+            let (lo, hi) = (lo.try_into().expect("LANES wide"), hi.try_into().expect("LANES wide"));
+            let balls = &mut balls[start / LANES];
+            let earliest = bracket_neighbours(particles, i, js, n_near - start, sim_box, now, lo, hi, balls);
+            bound = bound.min(earliest);
+        }
+        let (lo, hi, balls) = (&*lo, &*hi, &*balls);
+        // Pass 2: the candidates whose bracket reaches down to the bound. Which lanes are
+        // candidates is a coin toss for the branch predictor: they are marked without
+        // branches first, one bit each, and the bits are visited lowest first. Only the
+        // neighbours' lanes count: the padding of the last chunk brackets to [+∞, +∞] too,
+        // which an infinite bound (nothing else pending, as for a disk at rest) would reach.
+        const { assert!(NEAR <= 64) };
+        let mut marked = 0u64;
+        for (k, &lo) in lo[..lanes].iter().enumerate() {
+            marked |= ((lo <= bound) as u64) << k;
+        }
+        marked &= if n_near < 64 { (1u64 << n_near) - 1 } else { u64::MAX };
+        while marked != 0 {
+            let k = marked.trailing_zeros() as usize;
+            marked &= marked - 1;
+            let (j, lo, hi) = (near[k] as usize, lo[k], hi[k]);
+            let q = &particles[j];
+            let lanes = &balls[k / LANES];
+            let t = if lo == hi && lo < f64::INFINITY {
+                // Both ends round to the same absolute time: that is the time.
+                Some(lo)
+            } else if let Some(t) = (hi < f64::INFINITY).then(|| lanes.pinned(k % LANES, lo, hi, now)).flatten() {
+                // Pinned to one ulp, and settled (`Lanes::pinned`).
+                Some(t)
+            } else {
+                // The exact root, from the balls the brackets were built from.
+                lanes.predict(k % LANES, now)
+            };
+            if let Some(t) = t {
+                let kind = EventKind::Pair { partner: j as u32, partner_events: q.events };
+                consider(best, Event { time: t, kind });
+            }
+        }
+    }
+}
+
+/// The search one pair at a time, for the cases the batch cannot take: short periodic axes
+/// (several images per pair) and more than [`NEAR`] neighbours (tiny disks among large
+/// ones). Same events.
+#[cold]
+#[allow(clippy::too_many_arguments)]
+fn scalar<const D: usize>(
+    particles: &[Particle<D>],
+    sim_box: &SimBox<D>,
+    short: &[bool; D],
+    neighbours: &Neighbours<D>,
+    now: f64,
+    i: usize,
+    skip: usize,
+    best: &mut Event,
+) {
+    let p = &particles[i];
+    let owner = i as u32;
+    let consider = |best: &mut Event, e: Event| {
+        if e.before(owner, best, owner) {
+            *best = e;
+        }
+    };
+    // Pass 1: bracket every neighbour; `bound` is the earliest time some candidate is
+    // certain to reach (an exact event time, or the upper end of a bracket).
+    let mut bound = best.time;
+    let mut hits = [(0u32, 0.0f64); HITS];
+    let mut n_hits = 0;
+    for j in neighbours.candidates(i) {
+        if j == i || j == skip {
+            continue;
+        }
+        let q = &particles[j];
+        let exact = match pair::bracket(p, q, sim_box, now, short, bound) {
+            PairBracket::Beyond | PairBracket::Known(None) => continue,
+            PairBracket::Known(Some(t)) => t,
+            PairBracket::Between { lo, hi } if n_hits < HITS => {
+                hits[n_hits] = (j as u32, lo.max(now));
+                n_hits += 1;
+                bound = bound.min(hi.max(now));
+                continue;
+            }
+            // No room left to defer it: evaluate it now.
+            PairBracket::Between { .. } => pair::predict(p, q, sim_box, now, short).expect("a bracketed contact"),
+        };
+        let kind = EventKind::Pair { partner: j as u32, partner_events: q.events };
+        consider(best, Event { time: exact.max(now), kind });
+        bound = bound.min(best.time);
+    }
+    // Pass 2, as in the batch.
+    for &(j, lo) in &hits[..n_hits] {
+        if lo > bound {
+            continue;
+        }
+        let j = j as usize;
+        let q = &particles[j];
+        let t = pair::predict(p, q, sim_box, now, short).expect("a bracketed contact");
+        let kind = EventKind::Pair { partner: j as u32, partner_events: q.events };
+        consider(best, Event { time: t.max(now), kind });
+    }
+}
+
+/// [`pair::bracket`] for particle `i` against the neighbours `js[..len]` (up to [`LANES`])
+/// at once, when no axis is short, through the branch-free batch kernel
+/// [`contact_brackets`]. On return, for each `k < len`: if [`pair::predict`] gives `Some(t)`
+/// for the pair, then `lo[k] ≤ max(t, now) ≤ hi[k]` (absolute times); `lo[k] = +∞` when it
+/// gives `None` (or a time that itself overflows to `+∞`, so a caller searching up to an
+/// infinite bound still asks [`pair::predict`]). Lanes `k ≥ len` give `[+∞, +∞]` whatever
+/// `js[k]` holds, so a caller can always pass full chunks. Returns the smallest `hi[k]`.
+///
+/// The balls are exactly those [`pair::predict`] forms (so the certified intervals are
+/// [`pair::bracket`]'s to the bit), but built lane by lane without branches: the
+/// neighbours' states are gathered first, then the separations and image counts are
+/// computed for all lanes at once, which the compiler vectorizes. The balls are left in
+/// `lanes`, for the exact roots of the candidates ([`Lanes::predict`]).
+#[inline]
+#[allow(clippy::too_many_arguments)]
+pub fn bracket_neighbours<const D: usize>(
+    particles: &[Particle<D>],
+    i: usize,
+    js: &[u32; LANES],
+    len: usize,
+    sim_box: &SimBox<D>,
+    now: f64,
+    lo: &mut [f64; LANES],
+    hi: &mut [f64; LANES],
+    lanes: &mut Lanes<D>,
+) -> f64 {
+    let p = &particles[i];
+    let last = particles.len() - 1;
+    // Gather: the neighbours' states, one lane each (unused lanes pair `i` with itself).
+    let mut qx = [[0.0; LANES]; D];
+    let mut qv = [[0.0; LANES]; D];
+    let mut qt = [0.0; LANES];
+    let mut qr = [0.0; LANES];
+    for k in 0..LANES {
+        let j = std::hint::select_unpredictable(k < len, js[k] as usize, i).min(last);
+        let q = &particles[j];
+        for a in 0..D {
+            qx[a][k] = q.position[a];
+            qv[a][k] = q.velocity[a];
+        }
+        qt[k] = q.time;
+        qr[k] = q.radius;
+    }
+    // The balls, as `pair::predict` forms them: `i` at the origin (the same for every lane)
+    // and the neighbour at its separation at `t0`, the later update time, from `i` to the
+    // image nearest to `i` at `now`.
+    let Lanes { first, second, t0 } = lanes;
+    let mut separation = [[0.0; LANES]; D];
+    let mut apart = [[0.0; LANES]; D];
+    // Whether every lane's count was decided by comparisons, reduced in registers (a flag
+    // array stored lane by lane and read back as one vector stalls on store forwarding).
+    let mut decided = true;
+    for k in 0..LANES {
+        let t = p.time.max(qt[k]);
+        t0[k] = t;
+        for a in 0..D {
+            let d = motion::coordinate(qx[a][k], qv[a][k], now - qt[k])
+                - motion::coordinate(p.position[a], p.velocity[a], now - p.time);
+            let (count, known) = image_count_by_comparison(d, sim_box.lengths[a]);
+            let periodic = sim_box.boundary[a] == Boundary::Periodic;
+            let count = if periodic { count } else { 0.0 };
+            let at = motion::coordinate(qx[a][k], qv[a][k], t - qt[k])
+                - motion::coordinate(p.position[a], p.velocity[a], t - p.time);
+            first.velocity[a][k] = p.velocity[a];
+            second.position[a][k] = at + count * sim_box.lengths[a];
+            second.velocity[a][k] = qv[a][k];
+            separation[a][k] = d;
+            apart[a][k] = at;
+            decided &= known | !periodic;
+        }
+        first.radius[k] = p.radius;
+        second.radius[k] = qr[k];
+    }
+    // A separation near half a box length (or beyond 3/2) needs the division: rare.
+    if !decided {
+        for a in 0..D {
+            if sim_box.boundary[a] == Boundary::Periodic {
+                for k in 0..LANES {
+                    let count = image_count(separation[a][k], sim_box.lengths[a]);
+                    second.position[a][k] = apart[a][k] + count * sim_box.lengths[a];
+                }
+            }
+        }
+    }
+    contact_brackets(first, second, lo, hi);
+    for k in 0..LANES {
+        let used = k < len;
+        lo[k] = if used { (t0[k] + lo[k]).max(now) } else { f64::INFINITY };
+        hi[k] = if used { (t0[k] + hi[k]).max(now) } else { f64::INFINITY };
+    }
+    // Pairwise, while the ends are still in registers (a fold over the stored array is a
+    // serial chain of minima behind store-to-load forwarding).
+    const { assert!(LANES.is_power_of_two()) };
+    let mut m = *hi;
+    let mut width = LANES;
+    while width > 1 {
+        width /= 2;
+        for k in 0..width {
+            m[k] = m[k].min(m[k + width]);
+        }
+    }
+    m[0]
+}
+
+/// The balls of one chunk of [`bracket_neighbours`]' lanes, and the `t0` of each.
+#[derive(Clone, Copy, Debug, Default)]
+pub struct Lanes<const D: usize> {
+    /// The predicted particle, in every lane.
+    pub first: BallLanes<D, LANES>,
+    /// The neighbours.
+    pub second: BallLanes<D, LANES>,
+    /// The later update time of each pair.
+    pub t0: [f64; LANES],
+}
+
+impl<const D: usize> Lanes<D> {
+    /// [`pair::predict`] for the pair in lane `k` — the same number, as the balls are the
+    /// same (and with an infinite horizon the kernel's `contact_time_within` is
+    /// [`contact_time_unchecked`]), without forming them again from the particles.
+    #[inline]
+    pub fn predict(&self, k: usize, now: f64) -> Option<f64> {
+        pair::absolute(contact_time_unchecked(&self.first.get(k), &self.second.get(k)), self.t0[k]).map(|t| t.max(now))
+    }
+
+    /// [`predict`](Self::predict) for lane `k` when its bracket's ends `[lo, hi]` (absolute,
+    /// as [`bracket_neighbours`] leaves them) round to different times: [`narrow_contact`]
+    /// pins the kernel's time `t` to one of two adjacent doubles `x₁ < x₂`; when `t₀ ⊕ x₁` and
+    /// `t₀ ⊕ x₂` round to the same absolute time, that is `t₀ ⊕ t` (rounding is monotone),
+    /// and otherwise [`Narrowed::time`](quadratic::Narrowed::time) tells `t` itself. The same
+    /// number as `predict`'s; `None`: not settled (rarely), ask `predict`.
+    ///
+    /// Brackets are some tens of ulps of the contact time wide, and early in a run the
+    /// clock's ulp is only some tens of the contact time's, so a candidate's ends often round
+    /// apart: pinning settles most of those without the double-double root.
+    // Out of line, so that profiles show its cost.
+    #[inline(never)]
+    pub fn pinned(&self, k: usize, lo: f64, hi: f64, now: f64) -> Option<f64> {
+        let t0 = self.t0[k];
+        let guess = (lo - t0) + 0.5 * (hi - lo);
+        let narrowed = narrow_contact(&self.first.get(k), &self.second.get(k), guess)?;
+        let (a, b) = ((t0 + narrowed.lo()).max(now), (t0 + narrowed.hi()).max(now));
+        if a == b { Some(a) } else { narrowed.time().map(|t| (t0 + t).max(now)) }
+    }
+}

@@ -1,0 +1,94 @@
+//! The timing machinery, behind one wall: everything the engine does only to be fast on real
+//! hardware — the lookahead that prefetches the next event's data, the cache hint itself,
+//! huge pages for the large arrays, and the cache size that decides where the lookahead
+//! starts. Nothing here changes a result: with every part of it on or off, the events are the
+//! same bit for bit (tested), only the time differs.
+//!
+//! The engine meets it through [`Timing`] alone, at four points: once after the arrays are
+//! built ([`Timing::settle`]) and at three places in a step — before an event is resolved
+//! ([`Timing::begin`]), between the two predictions that follow a collision
+//! ([`Timing::middle`]) and after them ([`Timing::end`]). It reads the engine's structures
+//! through [`Reading`] and never writes them; the structures expose where their data lives,
+//! never a hint of their own.
+
+mod cache;
+mod lookahead;
+mod pages;
+mod prefetch;
+
+pub use lookahead::Ahead;
+pub(crate) use pages::LargeArray;
+pub use pages::{collect, filled, huge_page_bytes, moved};
+pub use prefetch::{prefetch, prefetch_address};
+
+use super::geometry::Particle;
+use super::neighbours::Neighbours;
+use super::params::{EngineParams, Switch};
+use super::queue::EventQueue;
+
+/// What the timing room may read: the engine's structures, as a step leaves them.
+pub(crate) struct Reading<'a, const D: usize> {
+    /// The particle records.
+    pub particles: &'a [Particle<D>],
+    /// The pending events.
+    pub queue: &'a EventQueue,
+    /// The neighbour lists or cells.
+    pub neighbours: &'a Neighbours<D>,
+}
+
+/// The timing machinery of one simulation (what [`EngineParams`] resolved to).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(crate) struct Timing {
+    /// Prefetch the next event's data while processing one.
+    pub(crate) lookahead: bool,
+    /// Move the large arrays into huge pages.
+    huge_pages: bool,
+}
+
+impl Timing {
+    /// The machinery for `n` particles: the lookahead from where the engine's state leaves
+    /// the level-2 cache ([`lookahead::pays`]), huge pages for the arrays large enough.
+    pub(crate) fn new(params: &EngineParams, n: usize) -> Timing {
+        Timing { lookahead: params.lookahead.resolve(lookahead::pays(n)), huge_pages: params.huge_pages != Switch::Off }
+    }
+
+    /// Moves each of the engine's large arrays into memory backed by huge pages (elements
+    /// unchanged), before the run touches them.
+    pub(crate) fn settle<'a>(&self, arrays: impl IntoIterator<Item = &'a mut dyn LargeArray>) {
+        if self.huge_pages {
+            for array in arrays {
+                array.settle();
+            }
+        }
+    }
+
+    /// Before the event of `a` (and `b`, for a pair) is resolved: with the lookahead, the
+    /// guess of the next event's owner, its data on its way (stage one); without it, the
+    /// partners' rows, read right after the collision.
+    #[inline(always)]
+    pub(crate) fn begin<const D: usize>(&self, at: &Reading<'_, D>, a: usize, b: Option<usize>) -> Option<usize> {
+        if self.lookahead {
+            Some(lookahead::first_stage(at, a, b.unwrap_or(a)))
+        } else {
+            if let Some(b) = b {
+                lookahead::own_rows(at, a, b);
+            }
+            None
+        }
+    }
+
+    /// Between the two predictions after a collision, or before the one after any other
+    /// event (stage two: the next owner's neighbourhood, its partner, its queue path).
+    #[inline(always)]
+    pub(crate) fn middle<const D: usize>(&self, at: &Reading<'_, D>, next: Option<usize>) -> Option<Ahead> {
+        next.map(|next| lookahead::second_stage(at, next))
+    }
+
+    /// After the predictions (stage three: what stage two's loads point to).
+    #[inline(always)]
+    pub(crate) fn end<const D: usize>(&self, at: &Reading<'_, D>, ahead: Option<&Ahead>) {
+        if let Some(ahead) = ahead {
+            lookahead::third_stage(at, ahead);
+        }
+    }
+}
