@@ -22,6 +22,7 @@
 //! The internals the benchmarks time are reachable through [`internals`], which is not part
 //! of the API.
 
+pub(crate) mod arrays;
 pub mod collision;
 pub mod geometry;
 pub mod init;

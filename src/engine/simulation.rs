@@ -20,6 +20,7 @@
 //! The speed machinery (prefetching the next event's data, huge pages) lives behind
 //! [`Timing`]; it is told where a step is and reads, never writes.
 
+use super::arrays::Visitor;
 use super::collision::Restitution;
 use super::geometry::{Boundary, Particle, SimBox};
 use super::neighbours::{Neighbourhood, Neighbours, Saved};
@@ -29,7 +30,7 @@ use super::search::{NEAR, Search};
 use super::setup::{OverlapAudit, RESTORE_OVERLAP, SetupError, validate};
 use super::sources::sample::Sampling;
 use super::sources::{self, Event, EventCounts, EventKind, Outcome, pair, wall};
-use super::timing::{LargeArray, Reading, Timing};
+use super::timing::{Reading, Timing};
 use nalgebra::SVector;
 use serde::{Deserialize, Serialize};
 
@@ -224,9 +225,11 @@ impl<const D: usize> Simulation<D> {
 
     /// Hands the large arrays to the timing room (huge pages), before the run touches them.
     fn settle(&mut self) {
-        let particles: &mut dyn LargeArray = &mut self.particles;
-        let arrays = std::iter::once(particles).chain(self.neighbours.large_arrays()).chain(self.queue.large_arrays());
-        self.timing.settle(arrays);
+        if let Some(mut pages) = self.timing.settle() {
+            pages.array(&mut self.particles);
+            self.neighbours.visit_arrays(&mut pages);
+            self.queue.visit_arrays(&mut pages);
+        }
     }
 
     /// Checks that the pending events are what a run leaves: every live event is the

@@ -11,6 +11,7 @@
 //!   each particle in the cell of its centre, which moves only when the particle leaves its
 //!   skin. No coordinate is stored: [`Cells::locate`] finds it from the centre.
 
+use crate::engine::arrays::Visitor;
 use crate::engine::geometry::{Boundary, SimBox};
 use crate::engine::motion;
 use nalgebra::SVector;
@@ -367,10 +368,9 @@ impl<const D: usize> Cells<D> {
         &self.head[c as usize]
     }
 
-    /// The links through the particles, for the timing room (which may move them into huge
-    /// pages).
-    pub(crate) fn links(&mut self) -> &mut dyn crate::engine::timing::LargeArray {
-        &mut self.next
+    /// Hands its large array (the links through the particles) to `visitor`.
+    pub(crate) fn visit_arrays(&mut self, visitor: &mut impl Visitor) {
+        visitor.array(&mut self.next);
     }
 
     /// The first particle in cell `c` and where its link is kept, if the cell holds one.

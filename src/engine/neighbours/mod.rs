@@ -34,6 +34,7 @@
 pub(crate) mod cells;
 pub(crate) mod lists;
 
+use crate::engine::arrays::Visitor;
 use crate::engine::geometry::{Boundary, Particle, SimBox};
 use crate::engine::motion;
 use cells::{Cells, Coord};
@@ -457,10 +458,11 @@ impl<const D: usize> Neighbours<D> {
         &self.centres
     }
 
-    /// The large arrays, for the timing room (which may move them into huge pages; nothing
-    /// else about them changes).
-    pub(crate) fn large_arrays(&mut self) -> [&mut dyn crate::engine::timing::LargeArray; 3] {
-        [&mut self.centres, &mut self.lists, self.cells.links()]
+    /// Hands its large arrays (centres, lists, the cells' links) to `visitor`.
+    pub(crate) fn visit_arrays(&mut self, visitor: &mut impl Visitor) {
+        visitor.array(&mut self.centres);
+        visitor.array(&mut self.lists);
+        self.cells.visit_arrays(visitor);
     }
 
     /// Checks the lists against their definition: `j` is on `i`'s list exactly when their

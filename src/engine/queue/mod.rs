@@ -181,11 +181,11 @@ impl EventQueue {
         }
     }
 
-    /// The large arrays, for the timing room (which may move them into huge pages).
-    pub(crate) fn large_arrays(&mut self) -> Vec<&mut dyn super::timing::LargeArray> {
-        match self {
-            EventQueue::Calendar(_) => Vec::new(),
-            EventQueue::Tree(q) => q.large_arrays(),
+    /// Hands its large arrays to `visitor` (the tree's; the calendar is used only while the
+    /// engine fits the caches).
+    pub(crate) fn visit_arrays(&mut self, visitor: &mut impl super::arrays::Visitor) {
+        if let EventQueue::Tree(q) = self {
+            q.visit_arrays(visitor);
         }
     }
 

@@ -266,9 +266,10 @@ impl Tree {
         }
     }
 
-    /// The large arrays, for the timing room (which may move them into huge pages).
-    pub(crate) fn large_arrays(&mut self) -> Vec<&mut dyn crate::engine::timing::LargeArray> {
-        vec![&mut self.groups, &mut self.quads]
+    /// Hands its large arrays (slots and nodes) to `visitor`.
+    pub(crate) fn visit_arrays(&mut self, visitor: &mut impl crate::engine::arrays::Visitor) {
+        visitor.array(&mut self.groups);
+        visitor.array(&mut self.quads);
     }
 
     /// Internal nodes, the root included (tree position `m + p` is slot `p`).

@@ -5,7 +5,8 @@
 //! same bit for bit (tested), only the time differs.
 //!
 //! The engine meets it through [`Timing`] alone, at four points: once after the arrays are
-//! built ([`Timing::settle`]) and at three places in a step — before an event is resolved
+//! built ([`Timing::settle`], shown each large array through [`Visitor`]) and at three places
+//! in a step — before an event is resolved
 //! ([`Timing::begin`]), between the two predictions that follow a collision
 //! ([`Timing::middle`]) and after them ([`Timing::end`]). It reads the engine's structures
 //! through [`Reading`] and never writes them; the structures expose where their data lives,
@@ -17,10 +18,10 @@ mod pages;
 mod prefetch;
 
 pub use lookahead::Ahead;
-pub(crate) use pages::LargeArray;
 pub use pages::{collect, filled, huge_page_bytes, moved};
 pub use prefetch::{prefetch, prefetch_address};
 
+use super::arrays::Visitor;
 use super::geometry::Particle;
 use super::neighbours::Neighbours;
 use super::params::{EngineParams, Switch};
@@ -52,14 +53,11 @@ impl Timing {
         Timing { lookahead: params.lookahead.resolve(lookahead::pays(n)), huge_pages: params.huge_pages != Switch::Off }
     }
 
-    /// Moves each of the engine's large arrays into memory backed by huge pages (elements
-    /// unchanged), before the run touches them.
-    pub(crate) fn settle<'a>(&self, arrays: impl IntoIterator<Item = &'a mut dyn LargeArray>) {
-        if self.huge_pages {
-            for array in arrays {
-                array.settle();
-            }
-        }
+    /// What moves the engine's large arrays into memory backed by huge pages (elements
+    /// unchanged), before the run touches them: shown every array, it moves those large
+    /// enough (`None`: huge pages are off).
+    pub(crate) fn settle(&self) -> Option<impl Visitor> {
+        self.huge_pages.then_some(pages::Settle)
     }
 
     /// Before the event of `a` (and `b`, for a pair) is resolved: with the lookahead, the

@@ -14,23 +14,21 @@
 //! nothing and the pages stay small: the results are the same bit for bit either way, only
 //! the speed differs.
 
+use crate::engine::arrays::Visitor;
+
 /// Arrays of fewer bytes keep ordinary pages: a few MB are within the reach of the TLB.
 const FROM_BYTES: usize = 4 << 20;
 
 /// The size of a huge page (x86-64 and aarch64 with 4 KB base pages).
 const HUGE: usize = 2 << 20;
 
-/// One of the engine's arrays, which the timing room may move into memory backed by huge
-/// pages: the elements, their order and the length stay as they were.
-pub(crate) trait LargeArray {
-    /// Moves the elements into memory advised for huge pages, if the array is large enough
-    /// for that to matter ([`moved`]).
-    fn settle(&mut self);
-}
+/// Moves each array it is shown into memory advised for huge pages, if the array is large
+/// enough for that to matter ([`moved`]).
+pub(crate) struct Settle;
 
-impl<T> LargeArray for Vec<T> {
-    fn settle(&mut self) {
-        *self = moved(std::mem::take(self));
+impl Visitor for Settle {
+    fn array<T>(&mut self, v: &mut Vec<T>) {
+        *v = moved(std::mem::take(v));
     }
 }
 
