@@ -17,7 +17,7 @@ fn run_to_end(mut run: Run<2>) -> (Run<2>, Summary) {
     let Ok(_) = run.complete(&mut Discard);
     assert!(run.done(), "events keep coming");
     // The wall-clock fields are the only ones a rerun may change.
-    let summary = Summary { wall_time_s: 0.0, collisions_per_second: 0.0, ..run.summary() };
+    let summary = reproducible(run.summary());
     (run, summary)
 }
 
@@ -174,4 +174,81 @@ fn ideal_gas_limit_with_one_disk() {
     let tolerance = 0.5 * m * (disk.velocity.x.abs() / ay + disk.velocity.y.abs() / ax) / t;
     let got = 0.5 * (px + py);
     assert!((got - expected).abs() <= tolerance, "{got} vs {expected} ± {tolerance}");
+}
+
+/// The registered velocity-distribution observable (`[observe.velocities]`): from a start at
+/// one speed (a₂ = −½, far from the Maxwellian) to equilibrium, where the last snapshot
+/// passes the Maxwellian's tests at their stated levels (KS below its 95 % critical value
+/// 1.358/√N; a₂ and the kurtosis within 3 standard errors). It is in the summary by name,
+/// kept in checkpoints (a resumed run ends with the same bits), and sees production only.
+#[test]
+fn the_velocity_observable_relaxes_to_the_maxwellian() {
+    use collide::observe::Observable;
+    let text = "seed = 5\n[box]\npacking_fraction = 0.3\nboundary = \"periodic\"\n\
+                [[species]]\ncount = 2000\nradius = 0.5\nmass = 1.0\n[init]\nvelocities = \"fixed-speed\"\n\
+                [run]\ntime = 20.0\nsample_interval = 2.0\n[observe.velocities]\nhistograms_at = [0, 10]\n";
+    let config = config(text);
+    let mut run = Run::<2>::new(config.clone()).unwrap();
+    let Ok(_) = run.complete(&mut Discard);
+    let Some(Observable::Velocities(v)) = run.observables.first() else { panic!("{:?}", run.observables) };
+    let n = 2000.0f64;
+    assert_eq!(v.snapshots.len(), 1 + run.thermo.samples.len());
+    assert_eq!(v.histograms.iter().map(|h| h.t).collect::<Vec<_>>(), [0.0, v.snapshots[10].t]);
+    let (first, last) = (&v.snapshots[0], v.snapshots.last().unwrap());
+    assert!((first.sonine_a2 + 0.5).abs() < 0.01 && first.ks > 0.3, "{first:?}");
+    assert!(last.ks <= 1.358 / n.sqrt(), "{last:?}");
+    assert!(last.sonine_a2.abs() <= 3.0 * last.sonine_a2_error, "{last:?}");
+    assert!((last.kurtosis - 3.0).abs() <= 3.0 * last.kurtosis_error, "{last:?}");
+    let summary = reproducible(run.summary());
+    assert_eq!(summary.observables["velocities"]["snapshots"].as_array().unwrap().len(), v.snapshots.len());
+    let json = serde_json::to_string(&run.summary()).unwrap();
+    assert!(json.contains("\"observe\":{\"velocities\":{\"histograms_at\":[0,10]}}"), "the configuration echoes it");
+
+    // Through a checkpoint taken mid-production, to the same bits.
+    let mut first = Run::<2>::new(config).unwrap();
+    let stop = AtomicBool::new(false);
+    struct StopAtSample<'a>(&'a AtomicBool);
+    impl Sink<2> for StopAtSample<'_> {
+        type Error = std::convert::Infallible;
+        fn event(&mut self, run: &Run<2>, _: &Outcome<2>) -> Result<(), Self::Error> {
+            if run.thermo.samples.len() >= 4 {
+                self.0.store(true, Ordering::Relaxed);
+            }
+            Ok(())
+        }
+    }
+    let Ok(_) = first.advance(&stop, &mut StopAtSample(&stop));
+    let text = first.checkpoint(0).to_json();
+    assert!(text.contains("\"observables\":[{\"velocities\""), "saved with the run");
+    let mut resumed = Run::resume(Checkpoint::<2>::from_json(text.as_bytes()).unwrap()).unwrap();
+    let Ok(_) = resumed.complete(&mut Discard);
+    assert_eq!(reproducible(resumed.summary()), summary);
+}
+
+/// An observer handed to a run sees every production event and nothing of the equilibration.
+#[test]
+fn an_observer_of_the_caller_sees_production_only() {
+    use collide::observe::Observer;
+    struct Count(u64, f64);
+    impl Observer<2> for Count {
+        fn observe(&mut self, sim: &Simulation<2>, outcome: &Outcome<2>) {
+            if let Outcome::Pair { .. } = outcome {
+                self.0 += 1;
+            }
+            self.1 = self.1.min(sim.time());
+        }
+    }
+    let mut run = equilibrated(periodic(100, 0.4, 3000, 2));
+    let start = run.sim.time();
+    let mut fresh = Run::new(periodic(100, 0.4, 3000, 2)).unwrap();
+    let mut count = Count(0, f64::INFINITY);
+    let Ok(_) = fresh.complete(&mut count);
+    assert_eq!(count.0, 3000);
+    assert!(count.1 > start, "an event at {} precedes production at {start}", count.1);
+    let Ok(_) = run.complete(&mut Discard);
+    assert_eq!(reproducible(run.summary()), reproducible(fresh.summary()));
+}
+
+fn reproducible(summary: Summary) -> Summary {
+    Summary { wall_time_s: 0.0, collisions_per_second: 0.0, ..summary }
 }

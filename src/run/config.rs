@@ -356,12 +356,17 @@ impl Config {
     /// Parses and validates TOML text for a 2D run; `source` names it in errors. A syntax
     /// error or an unknown key is reported with its line and column.
     pub fn parse(text: &str, source: &str) -> Result<Config, ConfigError> {
+        Config::parse_for(text, source, 2)
+    }
+
+    /// [`parse`](Self::parse) for a run in `dimension` dimensions.
+    pub fn parse_for(text: &str, source: &str, dimension: usize) -> Result<Config, ConfigError> {
         let config: Config = toml::from_str(text).map_err(|e| ConfigError::Syntax {
             source: source.to_string(),
             at: e.span().map(|span| line_column(text, span.start)),
             message: e.message().to_string(),
         })?;
-        config.check().map_err(|invalid| ConfigError::Invalid { source: source.to_string(), invalid })?;
+        config.check_for(dimension).map_err(|invalid| ConfigError::Invalid { source: source.to_string(), invalid })?;
         Ok(config)
     }
 
@@ -573,5 +578,45 @@ mod tests {
         let typo = error_of("placement = \"triangular\"", "placement = \"hexagonal\"");
         assert!(typo.contains("hexagonal"), "{typo}");
         assert!(Config::parse("this is not toml", "x.toml").unwrap_err().to_string().starts_with("x.toml: "));
+    }
+
+    /// The errors are typed: the field, the value and what is allowed can be read off them,
+    /// not only printed.
+    #[test]
+    fn errors_carry_the_field_the_value_and_what_is_allowed() {
+        let text = DEFAULT_CONFIG.replace("radius = 0.5", "radius = -1.0");
+        match Config::parse(&text, "t.toml") {
+            Err(ConfigError::Invalid { source, invalid: Invalid::Value { field, value, allowed } }) => {
+                assert_eq!((source.as_str(), field.as_str(), value.as_str()), ("t.toml", "species[0].radius", "-1"));
+                assert!(allowed.contains("positive finite"), "{allowed}");
+            }
+            other => panic!("{other:?}"),
+        }
+        match Config::parse("seed = 1\n[box]\nsize = [1.0]\n", "s.toml") {
+            Err(ConfigError::Syntax { at: Some((line, _)), .. }) => assert!(line >= 1),
+            other => panic!("{other:?}"),
+        }
+    }
+
+    /// A configuration is checked for its dimension: the entries of the box and the limit
+    /// of close packing follow it (π/(2√3) for disks, π/√18 for spheres).
+    #[test]
+    fn the_dimension_decides_the_box() {
+        let spheres = DEFAULT_CONFIG.replace("packing_fraction = 0.5", "size = [20.0, 20.0, 20.0]");
+        let config = Config::parse_for(&spheres, "3d", 3).expect("three edges in 3D");
+        assert_eq!(config.boundaries::<3>(), [Boundary::Periodic; 3]);
+        let err = Config::parse(&spheres, "2d").unwrap_err();
+        assert!(matches!(&err, ConfigError::Invalid { invalid: Invalid::Entries { entries: 3, .. }, .. }), "{err}");
+        assert!(err.to_string().contains("box.size has 3 entries: give [Lx, Ly]"), "{err}");
+        let two = Config::parse_for(DEFAULT_CONFIG, "2d in 3d", 3);
+        assert!(two.is_ok(), "a packing fraction makes a box in any dimension");
+        let dense = DEFAULT_CONFIG.replace("packing_fraction = 0.5", "packing_fraction = 0.8");
+        assert!(Config::parse(&dense, "disks").is_ok());
+        let err = Config::parse_for(&dense, "spheres", 3).unwrap_err().to_string();
+        assert!(err.contains("(0, 0.7405)") && err.contains("π/√18"), "{err}");
+        let lists = DEFAULT_CONFIG.replace("boundary = \"periodic\"", "boundary = [\"periodic\", \"wall\"]");
+        assert!(Config::parse(&lists, "2d").is_ok());
+        let err = Config::parse_for(&lists, "3d", 3).unwrap_err().to_string();
+        assert!(err.contains("box.boundary has 2 entries: give one per axis (3)"), "{err}");
     }
 }

@@ -1,0 +1,146 @@
+//! The product generic over the dimension: initial states, the engine against the reference,
+//! runs, checkpoints and trajectories in 3D as in 2D. (The 3D configuration key and the 3D
+//! experiments come later; here every piece is driven through the library.)
+
+use collide::engine::init::{InitError, Placement, Species, Velocities, box_for_packing_fraction, initial_particles};
+use collide::engine::{Boundary, Outcome, ReferenceSimulation, Simulation};
+use collide::run::output::xyz_frame;
+use collide::run::{Checkpoint, Config, Discard, Run, RunError, Summary};
+
+const EPS: f64 = f64::EPSILON;
+
+fn spheres(n: usize, eta: f64, boundary: &str, collisions: u64, seed: u64) -> Config {
+    let text = format!(
+        "seed = {seed}\n[box]\npacking_fraction = {eta}\nboundary = {boundary}\n\
+         [[species]]\ncount = {}\nradius = 0.5\nmass = 1.0\n[[species]]\ncount = {}\nradius = 0.4\nmass = 0.6\n\
+         [init]\nplacement = \"random\"\n[equilibration]\ncollisions = 5000\n\
+         [run]\ncollisions = {collisions}\nsample_interval = 0.5\n",
+        n / 2,
+        n - n / 2
+    );
+    Config::parse_for(&text, "spheres", 3).unwrap()
+}
+
+fn reproducible(summary: Summary) -> Summary {
+    Summary { wall_time_s: 0.0, collisions_per_second: 0.0, ..summary }
+}
+
+/// A mixture of spheres in a box periodic along x and y and walled along z: energy and the
+/// momentum along the periodic axes conserved to rounding, no overlap, the wall pressures of
+/// z only, and a checkpoint taken mid-run that resumes to the same bits.
+///
+/// Tolerances as in the 2D physics tests: rounding errors of independent collisions add like
+/// a random walk, |ΔK|/K ≤ 4ε√M over M collisions; an overlap is a few ε of the coordinates.
+#[test]
+fn a_run_of_spheres_conserves_and_resumes_bit_identically() {
+    let config = spheres(300, 0.25, r#"["periodic", "periodic", "wall"]"#, 60_000, 4);
+    let mut run = Run::<3>::new(config.clone()).unwrap();
+    let Ok(_) = run.equilibrate(&mut Discard);
+    let (p0, k0) = (run.sim.momentum(), run.sim.kinetic_energy());
+    let Ok(_) = run.complete(&mut Discard);
+    let whole = reproducible(run.summary());
+    let m = whole.collisions as f64;
+    assert_eq!(whole.collisions, 60_000);
+    assert!(whole.energy_relative_drift.abs() <= 4.0 * EPS * m.sqrt(), "{}", whole.energy_relative_drift);
+    assert!(((run.sim.kinetic_energy() - k0) / k0).abs() <= 4.0 * EPS * m.sqrt());
+    let dp = run.sim.momentum() - p0;
+    let scale: f64 = run.sim.particles().iter().map(|p| p.mass * p.velocity.norm()).sum();
+    assert!(dp[0].abs().max(dp[1].abs()) <= 4.0 * EPS * m.sqrt() * scale, "{dp}");
+    assert!(dp[2].abs() > 1e-3 * scale / 300.0, "the walls exchange momentum along z");
+    assert!(whole.max_overlap.fraction <= 1e-12, "{:?}", whole.max_overlap);
+    let axes: Vec<usize> = whole.wall_pressures.iter().map(|w| w.axis).collect();
+    assert_eq!(axes, [2, 2]);
+    assert!(whole.wall_pressures.iter().all(|w| w.pressure > 0.0));
+    assert!(whole.samples > 20 && whole.compressibility > 1.0);
+
+    // The same run, checkpointed at the end of equilibration and resumed from the JSON text.
+    let mut first = Run::<3>::new(config).unwrap();
+    let Ok(_) = first.equilibrate(&mut Discard);
+    let text = first.checkpoint(0).to_json();
+    let mut resumed = Run::resume(Checkpoint::<3>::from_json(text.as_bytes()).unwrap()).unwrap();
+    let Ok(_) = resumed.complete(&mut Discard);
+    assert_eq!(reproducible(resumed.summary()), whole);
+    assert_eq!(resumed.sim.particles(), run.sim.particles());
+}
+
+/// The fast engine and the O(N²) reference give the same collisions, to the bit, for spheres
+/// in periodic and walled boxes, one size and a mixture.
+#[test]
+fn spheres_collide_as_the_reference_says() {
+    for (boundary, seed) in [([Boundary::Periodic; 3], 1), ([Boundary::Wall; 3], 2)] {
+        let species =
+            [Species { count: 60, radius: 0.5, mass: 1.0 }, Species { count: 60, radius: 0.3, mass: 0.4 }].to_vec();
+        let sim_box = box_for_packing_fraction::<3>(&species, 0.2, boundary, Placement::Random, None);
+        let particles =
+            initial_particles(&species, &sim_box, Placement::Random, Velocities::Maxwell, 1.0, seed).unwrap();
+        let mut fast = Simulation::new(particles.clone(), sim_box).unwrap();
+        let mut slow = ReferenceSimulation::new(particles, sim_box);
+        for k in 0..3000 {
+            let expected = slow.step().expect("a collision");
+            let got = loop {
+                match fast.step().expect("an event") {
+                    Outcome::Pair { i, j, .. } => break (fast.time(), i, j),
+                    Outcome::Wall { i, .. } => break (fast.time(), i, i),
+                    _ => continue,
+                }
+            };
+            assert_eq!((got.0.to_bits(), got.1, got.2), (expected.0.to_bits(), expected.1, expected.2), "{k}");
+        }
+    }
+}
+
+/// Initial states in 3D: random placement without overlap, one speed per species with
+/// fixed-speed velocities (walls: no momentum removed), the temperature exact; the 2D
+/// lattices refused with the way out.
+#[test]
+fn initial_states_in_three_dimensions() {
+    let species = vec![Species { count: 500, radius: 0.5, mass: 2.0 }];
+    let sim_box = box_for_packing_fraction::<3>(&species, 0.3, [Boundary::Wall; 3], Placement::Random, None);
+    assert!((sim_box.volume() - 500.0 * 4.0 / 3.0 * std::f64::consts::PI * 0.125 / 0.3).abs() < 1e-9);
+    let particles = initial_particles(&species, &sim_box, Placement::Random, Velocities::FixedSpeed, 1.5, 9).unwrap();
+    let speeds: Vec<f64> = particles.iter().map(|p| p.velocity.norm()).collect();
+    let v = (3.0 * 1.5 / 2.0f64).sqrt();
+    assert!(speeds.iter().all(|s| (s - v).abs() <= 8.0 * EPS * v), "{:?}", &speeds[..3]);
+    let sim = Simulation::new(particles, sim_box).expect("inside the walls, no overlap");
+    assert!((sim.kt() - 1.5).abs() <= 8.0 * EPS * 1.5, "{}", sim.kt());
+    assert_eq!(sim.check_overlaps().at, None);
+    // Directions fill the sphere: the mean of each component is small against the speed.
+    let mean = sim.momentum() / (2.0 * 500.0 * v);
+    assert!(mean.norm() < 0.1, "{mean}");
+    for placement in [Placement::Triangular, Placement::Square] {
+        let err = initial_particles(&species, &sim_box, placement, Velocities::Maxwell, 1.0, 1).unwrap_err();
+        assert_eq!(err, InitError::NotInDimension { placement, dimension: 3 });
+        assert!(err.to_string().contains("is a 2D lattice; in 3D use placement = \"random\""), "{err}");
+    }
+    let config = Config::parse_for(
+        "seed = 1\n[box]\npacking_fraction = 0.3\nboundary = \"periodic\"\n[[species]]\ncount = 50\nradius = 0.5\nmass = 1.0\n[run]\ncollisions = 10\n",
+        "lattice",
+        3,
+    )
+    .unwrap();
+    let Err(RunError::Init(InitError::NotInDimension { .. })) = Run::<3>::new(config) else {
+        panic!("the default triangular lattice is 2D only")
+    };
+}
+
+/// Extended XYZ in 3D: real z coordinates inside the box, the third edge in the lattice, the
+/// periodicity of each axis.
+#[test]
+fn trajectory_frames_carry_z_in_three_dimensions() {
+    let mut run = Run::<3>::new(spheres(40, 0.1, r#"["periodic", "wall", "periodic"]"#, 200, 2)).unwrap();
+    let Ok(_) = run.complete(&mut Discard);
+    let frame = xyz_frame(&run.sim);
+    let lines: Vec<&str> = frame.lines().collect();
+    assert_eq!(lines[0], "40");
+    let l = run.sim.sim_box().lengths;
+    assert!(
+        lines[1].contains(&format!("Lattice=\"{} 0.0 0.0 0.0 {} 0.0 0.0 0.0 {}\"", l[0], l[1], l[2])),
+        "{}",
+        lines[1]
+    );
+    assert!(lines[1].contains("pbc=\"T F T\""), "{}", lines[1]);
+    let zs: Vec<f64> = lines[2..].iter().map(|row| row.split_whitespace().nth(3).unwrap().parse().unwrap()).collect();
+    assert_eq!(zs.len(), 40);
+    assert!(zs.iter().all(|&z| (0.0..l[2]).contains(&z)), "{zs:?}");
+    assert!(zs.iter().any(|&z| z != zs[0]), "z varies");
+}
