@@ -22,7 +22,7 @@
 //!   [`Sink`](run::Sink) (the files of `collide run`; every observer is one); it reports a
 //!   [`Summary`](run::Summary) and saves [`Checkpoint`](run::Checkpoint)s that continue it
 //!   bit-identically.
-//! * The [`lab`] turns runs into checks against the formulas of [`theory`]; [`bench`] times
+//! * The [`lab`] turns runs into checks against the formulas of [`theory`]; [`bench`](mod@bench) times
 //!   the engine beside the hardware's floor; [`query`] answers the numerical questions of
 //!   `collide roots` and `collide contact-time` line by line.
 //!

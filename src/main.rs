@@ -36,7 +36,7 @@ struct Cli {
 #[derive(Subcommand)]
 enum Command {
     /// Runs a simulation: `collide run [CONFIG.toml] [--out DIR]`, or `--resume CHECKPOINT`.
-    /// Without a file, runs the embedded default (see the README).
+    /// Without a file, runs the embedded default (`collide run --print-default` shows it).
     Run(RunArgs),
     /// Runs every physics experiment and writes a validation report (`index.html`,
     /// `report.md`); the default when no command is given. Exits non-zero if a check fails.

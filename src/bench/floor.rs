@@ -1,13 +1,12 @@
 //! The hardware's floor: what one collision costs on this machine when nothing but the
 //! arithmetic and the memory traffic of a collision is done.
 //!
-//! The speed issue measures how far an event-driven code is from the machine it runs on by
-//! a bare kernel: *move two disks, bounce, re-predict both against neighbour lists padded to
-//! the SIMD width; no queue, no list upkeep*. This module is that loop, written from the
-//! description, so that the floor can be measured on whatever machine the benchmark report
-//! runs on and the engine's rate given as a fraction of it — the figure that travels
-//! between hours and machines better than a rate (the issue quotes the fastest published
-//! code at 11–22 % of the floor it measured).
+//! How far an event-driven code is from the machine it runs on is measured by a bare kernel:
+//! *move two disks, bounce, re-predict both against neighbour lists padded to the SIMD width;
+//! no queue, no list upkeep*. This module is that loop, written from the description, so
+//! that the floor can be measured on whatever machine the benchmark report runs on and the
+//! engine's rate given as a fraction of it — the figure that travels between hours and
+//! machines better than a rate (the published figures are in `docs/benchmarks.md`).
 //!
 //! One step of the floor ([`Floor::collide`]):
 //!
@@ -31,8 +30,8 @@
 //! misjudges grazing pairs; see `quadratic::textbook`), and any check. The trajectories mean
 //! nothing; only the cost does. Records hold position, velocity and time in plain arrays,
 //! padded to one 64-byte cache line (as the engine's are: at 40 bytes, three records in
-//! eight straddled two lines, and N = 10⁶ took 340–400 ns a collision against 150–280);
-//! lists are 32 bytes a row, partners 4 bytes and due times 8.
+//! eight would straddle two lines); lists are 32 bytes a row, partners 4 bytes and due times
+//! 8.
 
 use super::state::{BenchError, initial_state};
 use crate::engine::SimBox;
@@ -43,8 +42,8 @@ use rand::{RngExt, SeedableRng};
 use serde::{Deserialize, Serialize};
 use std::time::Instant;
 
-/// Neighbours per disk: one AVX-512 register of f64 (the issue's floor went from 6 listed
-/// neighbours to 8 padded ones, 196 → 53 ns per collision).
+/// Neighbours per disk: one AVX-512 register of f64 (padded lists, so that every prediction
+/// is whole vectors).
 pub const WIDTH: usize = 8;
 
 /// How many steps ahead [`Floor::run`] draws the disks, and first prefetches their data.

@@ -56,13 +56,13 @@ pub struct BenchPoint {
     /// see `engine::pages`).
     #[serde(default)]
     pub huge_page_bytes: Option<u64>,
-    /// The hardware's floor for the same N and η on this machine ([`super::floor`]: move two
+    /// The hardware's floor for the same N and η on this machine ([`floor`]: move two
     /// disks, bounce, re-predict both against eight fixed neighbours; no queue, no list
     /// upkeep, no exact times), collisions per second — measured in the same process after
     /// the engine, with as many timed collisions.
     #[serde(default)]
     pub floor_collisions_per_second: Option<f64>,
-    /// Whether the floor's faster loop was the one that prefetches (`lab::floor::Floor::run`).
+    /// Whether the floor's faster loop was the one that prefetches (`bench::floor::Floor::run`).
     #[serde(default)]
     pub floor_lookahead: Option<bool>,
     /// `collisions_per_second / floor_collisions_per_second`.
@@ -131,14 +131,12 @@ pub fn measure(
     })
 }
 
-/// Untimed warm-up collisions per particle before a point is timed. The lattice relaxes
-/// slowly at η = 0.65: list rebuilds per collision, a measure of how far the disks wander,
-/// were 0.057, 0.074, 0.096, 0.107, 0.114 and 0.119 after 1, 2, 5, 8, 12 and 20 collisions
-/// per particle, and 0.117–0.124 from there to 160 (N = 10⁴, 2·10⁴–5·10⁴ collisions counted
-/// each; the same at N = 10⁵: 0.096 after 5, 0.119 after 20). Timed before that, large N
-/// measured the rattling lattice: at N = 10⁶, 0.98·10⁶ collisions/s after 1 per particle
-/// against 0.80·10⁶/s after 20 (one run each). At η = 0.3 the rate is steady from the first
-/// collision on (1.32–1.34 cell crossings per collision after 1 to 20).
+/// Untimed warm-up collisions per particle before a point is timed: the lattice start
+/// relaxes slowly at η = 0.65, and a point timed before the steady state measures a rattling
+/// lattice with half the list rebuilds of the fluid. List rebuilds per collision, a measure
+/// of how far the disks wander, reach their steady value (about 0.12) after some 20
+/// collisions per particle at any N; at η = 0.3 the rate is steady from the first collision
+/// on (the counts are in `benches/HISTORY.md`).
 pub const WARMUP: u64 = 20;
 
 /// The matrix: (N, η) pairs, warm-up collisions per particle, timed collisions for N.
@@ -199,7 +197,7 @@ pub fn markdown(points: &[BenchPoint], command: &str, machine: &str) -> String {
     md.push_str(
         "\nThe floor: the same N and η with nothing but moving two disks, bouncing them and \
          re-predicting both against eight fixed neighbours with the textbook formula (no queue, \
-         no list upkeep, no exact times; `collide::lab::floor`), measured in the same process.\n",
+         no list upkeep, no exact times; `collide::bench::floor`), measured in the same process.\n",
     );
     md
 }

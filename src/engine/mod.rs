@@ -1,5 +1,5 @@
 //! The collision engine: particles in a box, events predicted (pure) and resolved (mutating)
-//! by their [sources](sources), one [`Simulation`] that owns them all, and a brute-force
+//! by their [`sources`], one [`Simulation`] that owns them all, and a brute-force
 //! [`ReferenceSimulation`] to check it against.
 //!
 //! The rooms, in the order data flows through a step:

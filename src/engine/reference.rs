@@ -1,7 +1,7 @@
 //! The slow exact reference: after every event, every pair and every particle's other
 //! sources (its walls) are predicted again from scratch (O(N²) per event), with the same
 //! pure predictions and in the same total order as the engine
-//! ([`sources`](super::sources)), and the earliest is resolved. No queue, no cells, no
+//! ([`super::sources`]), and the earliest is resolved. No queue, no cells, no
 //! invalidation — nothing to get wrong. Tests run it beside
 //! [`Simulation`](super::Simulation) on small systems and require the same sequence of events,
 //! bit for bit.

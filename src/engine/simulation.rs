@@ -18,9 +18,9 @@
 //! [`ReferenceSimulation`](super::ReferenceSimulation) checks this bit for bit.
 //!
 //! The speed machinery (prefetching the next event's data, huge pages) lives behind
-//! [`Timing`]; it is told where a step is and reads, never writes.
+//! the timing room (`engine/timing/`); it is told where a step is and reads, never writes.
 
-use super::arrays::Visitor;
+use super::arrays::Store;
 use super::collision::Restitution;
 use super::geometry::{Boundary, Particle, SimBox};
 use super::neighbours::{Neighbourhood, Neighbours, Saved};
@@ -113,9 +113,15 @@ impl<const D: usize> Simulation<D> {
         let time = particles.iter().map(|p| p.time).fold(f64::NEG_INFINITY, f64::max);
         let short = pair::short_axes(&sim_box, reach);
         let batch = !short.contains(&true);
-        let neighbours = Neighbours::new(&sim_box, reach, &particles, time, batch, params.neighbourhood);
+        let timing = Timing::new(&params, n);
+        // The particles move into the timing room's store first, while nothing else is
+        // allocated (the move holds both copies for a moment); the rest is built there.
+        let store = timing.store();
+        let particles = store.moved(particles);
+        let neighbours = Neighbours::new(&sim_box, reach, &particles, time, batch, params.neighbourhood, &store);
+        let queue = EventQueue::nothing_in(n, queue_kind(&params, n), &store);
         let mut sim = Simulation {
-            queue: EventQueue::nothing(n, queue_kind(&params, n)),
+            queue,
             particles,
             short,
             sim_box,
@@ -126,9 +132,8 @@ impl<const D: usize> Simulation<D> {
             counts: EventCounts::default(),
             sampling: Sampling::default(),
             search: Search::new(batch),
-            timing: Timing::new(&params, n),
+            timing,
         };
-        sim.settle();
         sim.refuse_overlaps(0.0)?;
         sim.predict_everyone();
         Ok(sim)
@@ -187,11 +192,15 @@ impl<const D: usize> Simulation<D> {
         };
         let short = pair::short_axes(&sim_box, reach);
         let batch = !short.contains(&true);
-        let neighbours = match Neighbours::restore(&sim_box, reach, n, batch, state.neighbourhood, saved) {
+        let params = EngineParams::with_neighbourhood(state.neighbourhood);
+        let timing = Timing::new(&params, n);
+        let store = timing.store();
+        let particles = store.moved(state.particles);
+        let neighbours = match Neighbours::restore(&sim_box, reach, n, batch, state.neighbourhood, saved, &store) {
             Ok(neighbours) => neighbours,
             Err(what) => return bad(what),
         };
-        for (i, p) in state.particles.iter().enumerate() {
+        for (i, p) in particles.iter().enumerate() {
             if !neighbours.inside(i, p, state.time) {
                 return bad(match neighbours.listed() {
                     true => format!(
@@ -202,34 +211,24 @@ impl<const D: usize> Simulation<D> {
                 });
             }
         }
-        let params = EngineParams::with_neighbourhood(state.neighbourhood);
-        let mut sim = Simulation {
+        let queue = EventQueue::new_in(state.pending, queue_kind(&params, n), &store);
+        let sim = Simulation {
             neighbours,
             params,
-            particles: state.particles,
+            particles,
             search: Search::new(batch),
-            timing: Timing::new(&params, n),
+            timing,
             short,
             sim_box,
-            queue: EventQueue::new(state.pending, queue_kind(&params, n)),
+            queue,
             time: state.time,
             restitution: Restitution::ELASTIC,
             counts: state.counts,
             sampling,
         };
-        sim.settle();
         sim.refuse_overlaps(RESTORE_OVERLAP)?;
         sim.check_pending().map_err(|what| SetupError::BadState { what })?;
         Ok(sim)
-    }
-
-    /// Hands the large arrays to the timing room (huge pages), before the run touches them.
-    fn settle(&mut self) {
-        if let Some(mut pages) = self.timing.settle() {
-            pages.array(&mut self.particles);
-            self.neighbours.visit_arrays(&mut pages);
-            self.queue.visit_arrays(&mut pages);
-        }
     }
 
     /// Checks that the pending events are what a run leaves: every live event is the

@@ -440,7 +440,7 @@ pub fn contact_brackets<const D: usize, const L: usize>(
 /// evaluation for `time`), with no branch on the data.
 ///
 /// (Pinning is for the candidates whose brackets do leave two times; done for every lane of
-/// the engine's batch of neighbours instead, in vector registers, it measured 6 % slower.)
+/// the engine's batch of neighbours instead, in vector registers, it costs more than it saves.)
 ///
 /// How. With `F(x) = |Δr + Δv·x|² − σ²` (the exact differences of the inputs, as TwoSum
 /// pairs), one Newton step from the guess gives `c = guess − F(guess)/F′(guess)`, within about

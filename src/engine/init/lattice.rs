@@ -15,7 +15,7 @@
 
 use super::InitError;
 use crate::engine::geometry::{Boundary, SimBox};
-use nalgebra::{SVector, Vector2};
+use nalgebra::SVector;
 
 /// The two lattices.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -119,14 +119,14 @@ fn coordinate(k: usize, offset: f64, count: usize, l: f64, boundary: Boundary, r
 /// `rmax` and `rmin` are the largest and smallest radii; `eta` the packing fraction (for
 /// the error). Fails when even the best shape puts two sites closer than the smallest
 /// diameter (every pair of neighbours would overlap).
-pub(super) fn sites(
+pub(super) fn sites<const D: usize>(
     kind: Kind,
     n: usize,
     sim_box: &SimBox<2>,
     rmax: f64,
     rmin: f64,
     eta: f64,
-) -> Result<Vec<SVector<f64, 2>>, InitError> {
+) -> Result<Vec<SVector<f64, D>>, InitError> {
     let even_rows = kind == Kind::Triangular && sim_box.boundary[1] == Boundary::Periodic;
     let diameter = 2.0 * rmax;
     let mut shape = canonical(kind, n, even_rows);
@@ -164,7 +164,7 @@ pub(super) fn sites(
         let max_offset = kind.max_offset();
         let x = |col| coordinate(col, offset, nx, sim_box.lengths[0], sim_box.boundary[0], rmax, max_offset);
         let y = coordinate(row, 0.0, ny, sim_box.lengths[1], sim_box.boundary[1], rmax, 0.0);
-        out.extend((0..nx).map(|col| Vector2::new(x(col), y)));
+        out.extend((0..nx).map(|col| SVector::from_fn(|a, _| [x(col), y, 0.0][a])));
     }
     Ok(out)
 }
@@ -172,6 +172,7 @@ pub(super) fn sites(
 #[cfg(test)]
 mod tests {
     use super::*;
+    use nalgebra::Vector2;
 
     fn brute_nearest(sites: &[SVector<f64, 2>], sim_box: &SimBox<2>) -> f64 {
         let mut best = f64::INFINITY;

@@ -296,7 +296,7 @@ pub fn initial_particles<const D: usize>(
                 // Keep a spatial order (row-major) for cache locality; vacancies stay random.
                 sites.sort_by(|a, b| a[1].total_cmp(&b[1]).then(a[0].total_cmp(&b[0])));
             }
-            sites.into_iter().map(|x| SVector::from_fn(|a, _| x[a])).collect()
+            sites
         }
     };
     let mut particles: Vec<Particle<D>> = positions

@@ -11,7 +11,7 @@
 //!   each particle in the cell of its centre, which moves only when the particle leaves its
 //!   skin. No coordinate is stored: [`Cells::locate`] finds it from the centre.
 
-use crate::engine::arrays::Visitor;
+use crate::engine::arrays::Store;
 use crate::engine::geometry::{Boundary, SimBox};
 use crate::engine::motion;
 use nalgebra::SVector;
@@ -149,8 +149,13 @@ impl<const D: usize> Cells<D> {
     }
 
     /// A grid following the particles at `positions` (unwrapped), with cells at least
-    /// `width·(1 + 10⁻⁹)` wide.
-    pub fn follow(sim_box: &SimBox<D>, width: f64, positions: impl Iterator<Item = SVector<f64, D>>) -> Self {
+    /// `width·(1 + 10⁻⁹)` wide; its links built in `store`.
+    pub(crate) fn follow(
+        sim_box: &SimBox<D>,
+        width: f64,
+        positions: impl Iterator<Item = SVector<f64, D>>,
+        store: &impl Store,
+    ) -> Self {
         let cells = Cells::new(sim_box, width, std::iter::empty());
         let coords = positions
             .map(|r| {
@@ -163,17 +168,17 @@ impl<const D: usize> Cells<D> {
                 })
             })
             .collect();
-        cells.with_coords(coords)
+        cells.with_coords(coords, store)
     }
 
     /// A grid following particles with the given unwrapped coordinates (checkpoints).
-    pub fn from_coords(sim_box: &SimBox<D>, width: f64, coords: Vec<[i64; D]>) -> Self {
-        Cells::new(sim_box, width, std::iter::empty()).with_coords(coords)
+    pub(crate) fn from_coords(sim_box: &SimBox<D>, width: f64, coords: Vec<[i64; D]>, store: &impl Store) -> Self {
+        Cells::new(sim_box, width, std::iter::empty()).with_coords(coords, store)
     }
 
-    fn with_coords(mut self, mut coords: Vec<[i64; D]>) -> Self {
+    fn with_coords(mut self, mut coords: Vec<[i64; D]>, store: &impl Store) -> Self {
         coords.shrink_to_fit();
-        self.next = vec![NONE; coords.len() + 1];
+        self.next = store.filled(coords.len() + 1, NONE);
         self.wrapped = coords.iter().map(|m| self.wrap_axes(m)).collect();
         self.coords = coords;
         for i in 0..self.coords.len() {
@@ -366,11 +371,6 @@ impl<const D: usize> Cells<D> {
     #[inline]
     pub(crate) fn head(&self, c: u32) -> &u32 {
         &self.head[c as usize]
-    }
-
-    /// Hands its large array (the links through the particles) to `visitor`.
-    pub(crate) fn visit_arrays(&mut self, visitor: &mut impl Visitor) {
-        visitor.array(&mut self.next);
     }
 
     /// The first particle in cell `c` and where its link is kept, if the cell holds one.

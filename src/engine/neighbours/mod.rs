@@ -34,7 +34,7 @@
 pub(crate) mod cells;
 pub(crate) mod lists;
 
-use crate::engine::arrays::Visitor;
+use crate::engine::arrays::Store;
 use crate::engine::geometry::{Boundary, Particle, SimBox};
 use crate::engine::motion;
 use cells::{Cells, Coord};
@@ -137,28 +137,29 @@ pub enum Saved<const D: usize> {
 
 impl<const D: usize> Neighbours<D> {
     /// Lists (centred where the particles are at `time`) or a grid following the particles,
-    /// as `skin_for` decides; `allow_lists` is false with short periodic axes.
-    pub fn new(
+    /// as `skin_for` decides; `allow_lists` is false with short periodic axes. The large
+    /// arrays are built in `store`.
+    pub(crate) fn new(
         sim_box: &SimBox<D>,
         reach: f64,
         particles: &[Particle<D>],
         time: f64,
         allow_lists: bool,
         choice: Neighbourhood,
+        store: &impl Store,
     ) -> Self {
         match skin_for(sim_box, reach, particles.len(), allow_lists, choice) {
-            Some(_) => {
-                let centres = particles.iter().map(|p| p.position_at(time)).collect();
-                Self::restore(sim_box, reach, particles.len(), allow_lists, choice, Saved::Centres(centres, Vec::new()))
-                    .expect("one centre per particle")
+            Some(skin) => {
+                let centres = store.collect(particles.iter().map(|p| p.position_at(time)));
+                Self::listed_from(sim_box, reach, skin, centres, &[], store)
             }
-            None => Self::following(sim_box, reach, particles),
+            None => Self::following(sim_box, reach, particles, store),
         }
     }
 
     /// A grid of cells `reach` wide following the particles, no lists.
-    pub fn following(sim_box: &SimBox<D>, reach: f64, particles: &[Particle<D>]) -> Self {
-        Self::bare(sim_box, Cells::follow(sim_box, reach, particles.iter().map(|p| p.position_at(p.time))))
+    pub(crate) fn following(sim_box: &SimBox<D>, reach: f64, particles: &[Particle<D>], store: &impl Store) -> Self {
+        Self::bare(sim_box, Cells::follow(sim_box, reach, particles.iter().map(|p| p.position_at(p.time)), store))
     }
 
     /// The grid alone, no lists.
@@ -176,20 +177,23 @@ impl<const D: usize> Neighbours<D> {
         }
     }
 
-    /// Rebuilds from a saved state; `Err` says what does not fit (the wrong kind for this
-    /// box and density, or the wrong count).
-    pub fn restore(
+    /// Rebuilds from a saved state, its large arrays in `store`; `Err` says what does not fit
+    /// (the wrong kind for this box and density, or the wrong count).
+    pub(crate) fn restore(
         sim_box: &SimBox<D>,
         reach: f64,
         n: usize,
         allow_lists: bool,
         choice: Neighbourhood,
         saved: Saved<D>,
+        store: &impl Store,
     ) -> Result<Self, String> {
         let skin = skin_for(sim_box, reach, n, allow_lists, choice);
         let empty = |cells| Self::bare(sim_box, cells);
         match (skin, saved) {
-            (None, Saved::Cells(coords)) if coords.len() == n => Ok(empty(Cells::from_coords(sim_box, reach, coords))),
+            (None, Saved::Cells(coords)) if coords.len() == n => {
+                Ok(empty(Cells::from_coords(sim_box, reach, coords, store)))
+            }
             (Some(skin), Saved::Centres(centres, crowded)) if centres.len() == n => {
                 if let Some(&k) = crowded.iter().find(|&&k| k as usize >= n) {
                     return Err(format!("crowded particle {k} of {n}"));
@@ -197,30 +201,42 @@ impl<const D: usize> Neighbours<D> {
                 if crowded.windows(2).any(|w| w[0] >= w[1]) {
                     return Err("the crowded particles are not listed in increasing order".into());
                 }
-                let range = reach + skin;
-                let half = 0.5 * skin * (1.0 - f64::EPSILON * (1u64 << 32) as f64);
-                let mut neighbours = empty(Cells::new(sim_box, range, centres.iter().copied()));
-                neighbours.centres = centres;
-                neighbours.listed = true;
-                neighbours.range2 = range * range;
-                neighbours.exit2 = half * half;
-                neighbours.bound2 = 0.25 * skin * skin;
-                neighbours.lists = (0..n)
-                    .map(|i| {
-                        neighbours.scan(i);
-                        List::from_members(&neighbours.scratch)
-                    })
-                    .collect();
-                for &k in &crowded {
-                    neighbours.lists[k as usize] = List::CROWDED;
-                }
-                Ok(neighbours)
+                Ok(Self::listed_from(sim_box, reach, skin, store.moved(centres), &crowded, store))
             }
             (skin, _) => Err(format!(
                 "{n} {} expected",
                 if skin.is_some() { "neighbour-list centres" } else { "cell coordinates" }
             )),
         }
+    }
+
+    /// Lists with a skin `skin` around `centres` (already in `store`), the `crowded`
+    /// particles (in increasing order) searching the grid.
+    fn listed_from(
+        sim_box: &SimBox<D>,
+        reach: f64,
+        skin: f64,
+        centres: Vec<SVector<f64, D>>,
+        crowded: &[u32],
+        store: &impl Store,
+    ) -> Self {
+        let n = centres.len();
+        let range = reach + skin;
+        let half = 0.5 * skin * (1.0 - f64::EPSILON * (1u64 << 32) as f64);
+        let mut neighbours = Self::bare(sim_box, Cells::new(sim_box, range, centres.iter().copied()));
+        neighbours.centres = centres;
+        neighbours.listed = true;
+        neighbours.range2 = range * range;
+        neighbours.exit2 = half * half;
+        neighbours.bound2 = 0.25 * skin * skin;
+        neighbours.lists = store.collect((0..n).map(|i| {
+            neighbours.scan(i);
+            List::from_members(&neighbours.scratch)
+        }));
+        for &k in crowded {
+            neighbours.lists[k as usize] = List::CROWDED;
+        }
+        neighbours
     }
 
     /// What [`restore`](Self::restore) takes back.
@@ -458,13 +474,6 @@ impl<const D: usize> Neighbours<D> {
         &self.centres
     }
 
-    /// Hands its large arrays (centres, lists, the cells' links) to `visitor`.
-    pub(crate) fn visit_arrays(&mut self, visitor: &mut impl Visitor) {
-        visitor.array(&mut self.centres);
-        visitor.array(&mut self.lists);
-        self.cells.visit_arrays(visitor);
-    }
-
     /// Checks the lists against their definition: `j` is on `i`'s list exactly when their
     /// centres are within range (for the particles that are not crowded); for tests.
     #[cfg(test)]
@@ -518,7 +527,15 @@ mod tests {
             })
             .collect();
         let sim_box = SimBox { lengths: SVector::from([l, l]), boundary: [Boundary::Periodic; 2] };
-        let neighbours = Neighbours::new(&sim_box, 2.0 * radius, &particles, 0.0, true, Neighbourhood::Lists);
+        let neighbours = Neighbours::new(
+            &sim_box,
+            2.0 * radius,
+            &particles,
+            0.0,
+            true,
+            Neighbourhood::Lists,
+            &crate::engine::arrays::Plain,
+        );
         assert!(neighbours.listed());
         let (exit, bound) = (neighbours.exit2.sqrt(), neighbours.bound2.sqrt());
         let mut rng = Xoshiro256PlusPlus::seed_from_u64(5);

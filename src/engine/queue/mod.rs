@@ -7,8 +7,7 @@
 //! * a 4-ary **tournament tree** ([`tree`]): replacing an event walks ⌈log₄ N⌉ levels to the
 //!   root, each one cache line, and the path depends only on the particle — so the engine's
 //!   lookahead can prefetch it. The calendar's lists are found from the new event's time,
-//!   which is not known before the prediction: at N = 10⁶ every update missed the cache, and
-//!   the engine ran 25 % slower with it.
+//!   which is not known before the prediction, so at large N every update misses the cache.
 //!
 //! Every particle owns exactly one slot, so neither structure grows nor holds stale copies
 //! (a binary heap of every prediction held about five stale events per collision at packing
@@ -20,6 +19,7 @@
 //! [`CALENDAR_BELOW`] particles on, memory latency rules and the tree's prefetchable paths
 //! win (the measurements are in `benches/HISTORY.md`).
 
+use super::arrays::{Plain, Store};
 use super::sources::{Event, EventKind};
 
 pub mod calendar;
@@ -35,9 +35,9 @@ pub const CALENDAR_BELOW: usize = 3 << 14;
 /// Which structure an [`EventQueue`] uses.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum QueueKind {
-    /// [`Calendar`].
+    /// Time buckets (`calendar.rs`).
     Calendar,
-    /// [`Tree`].
+    /// A tournament tree (`tree.rs`).
     Tree,
 }
 
@@ -79,7 +79,7 @@ pub(crate) enum Reads {
     Path,
 }
 
-/// One pending event per particle, earliest first: a [`Calendar`] or a [`Tree`].
+/// One pending event per particle, earliest first: a calendar or a tournament tree.
 #[derive(Clone, Debug)]
 pub enum EventQueue {
     /// Time buckets.
@@ -91,17 +91,23 @@ pub enum EventQueue {
 impl EventQueue {
     /// A queue over `pending` (one event per particle, at most [`MAX_PARTICLES`]).
     pub fn new(pending: Vec<Event>, kind: QueueKind) -> Self {
+        EventQueue::new_in(pending, kind, &Plain)
+    }
+
+    /// [`new`](Self::new), the tree's arrays built in `store` (the calendar is used only
+    /// while the engine fits the caches, in ordinary vectors).
+    pub(crate) fn new_in(pending: Vec<Event>, kind: QueueKind, store: &impl Store) -> Self {
         match kind {
             QueueKind::Calendar => EventQueue::Calendar(Calendar::new(pending)),
-            QueueKind::Tree => EventQueue::Tree(Tree::new(pending)),
+            QueueKind::Tree => EventQueue::Tree(Tree::new(pending, store)),
         }
     }
 
-    /// A queue of `n` particles with nothing pending.
-    pub fn nothing(n: usize, kind: QueueKind) -> Self {
+    /// A queue of `n` particles with nothing pending, the tree's arrays built in `store`.
+    pub(crate) fn nothing_in(n: usize, kind: QueueKind, store: &impl Store) -> Self {
         match kind {
             QueueKind::Calendar => EventQueue::Calendar(Calendar::nothing(n)),
-            QueueKind::Tree => EventQueue::Tree(Tree::nothing(n)),
+            QueueKind::Tree => EventQueue::Tree(Tree::nothing(n, store)),
         }
     }
 
@@ -178,14 +184,6 @@ impl EventQueue {
         match self {
             EventQueue::Calendar(q) => q.footprint(owner, reads, touch),
             EventQueue::Tree(q) => q.footprint(owner, reads, touch),
-        }
-    }
-
-    /// Hands its large arrays to `visitor` (the tree's; the calendar is used only while the
-    /// engine fits the caches).
-    pub(crate) fn visit_arrays(&mut self, visitor: &mut impl super::arrays::Visitor) {
-        if let EventQueue::Tree(q) = self {
-            q.visit_arrays(visitor);
         }
     }
 

@@ -19,6 +19,7 @@
 
 use super::Reads;
 use super::Slot;
+use crate::engine::arrays::Store;
 use crate::engine::sources::{Event, MAX_PARTICLES};
 
 /// Children per internal node.
@@ -84,9 +85,10 @@ pub(super) fn guess_levels(n: usize) -> usize {
 pub(super) const TOP: usize = 21;
 
 impl Tree {
-    /// A queue over `pending` (one event per particle, at most [`MAX_PARTICLES`]).
-    pub fn new(pending: Vec<Event>) -> Self {
-        let mut queue = Tree::nothing(pending.len());
+    /// A queue over `pending` (one event per particle, at most [`MAX_PARTICLES`]), its arrays
+    /// built in `store`.
+    pub(crate) fn new(pending: Vec<Event>, store: &impl Store) -> Self {
+        let mut queue = Tree::nothing(pending.len(), store);
         for (p, e) in pending.into_iter().enumerate() {
             *queue.slot_mut(p) = Slot::pack(e);
         }
@@ -96,7 +98,7 @@ impl Tree {
 
     /// A queue of `n` particles with nothing pending (no temporary list of events: at
     /// N = 10⁶ one cost 24 MB of peak memory).
-    pub fn nothing(n: usize) -> Self {
+    pub(crate) fn nothing(n: usize, store: &impl Store) -> Self {
         assert!(n >= 1 && n <= MAX_PARTICLES, "1 ≤ n ≤ 2³² − 5 particles");
         let mut slots = n;
         while (slots - 1) % (ARITY - 1) != 0 {
@@ -107,12 +109,12 @@ impl Tree {
         let shift = (m + ARITY - 1) % ARITY;
         let empty = Group([Slot::pack(Event::NOTHING); ARITY]);
         let mut queue = Tree {
-            groups: vec![empty; (slots + shift).div_ceil(ARITY)],
+            groups: store.filled((slots + shift).div_ceil(ARITY), empty),
             shift,
             n,
             m,
             root: NO_NODE,
-            quads: vec![Quad([NO_NODE; ARITY]); m.saturating_sub(1).div_ceil(ARITY)],
+            quads: store.filled(m.saturating_sub(1).div_ceil(ARITY), Quad([NO_NODE; ARITY])),
             skip: guess_levels(n),
         };
         // Built even though every time is +∞: the winners of those ties are decided by the
@@ -264,12 +266,6 @@ impl Tree {
                 touch((quad as *const Quad).cast());
             }
         }
-    }
-
-    /// Hands its large arrays (slots and nodes) to `visitor`.
-    pub(crate) fn visit_arrays(&mut self, visitor: &mut impl crate::engine::arrays::Visitor) {
-        visitor.array(&mut self.groups);
-        visitor.array(&mut self.quads);
     }
 
     /// Internal nodes, the root included (tree position `m + p` is slot `p`).

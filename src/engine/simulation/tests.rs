@@ -126,7 +126,7 @@ fn lists_keep_their_definition_and_the_collisions_of_the_grid() {
     assert!(listed.neighbours.listed());
     let mut grid = listed.clone();
     let reach = 2.0 * grid.particles.iter().map(|p| p.radius).fold(0.0, f64::max);
-    grid.neighbours = Neighbours::following(&grid.sim_box, reach, &grid.particles);
+    grid.neighbours = Neighbours::following(&grid.sim_box, reach, &grid.particles, &crate::engine::arrays::Plain);
     grid.predict_everyone();
     assert!(!grid.neighbours.listed());
     let (mut listed, mut checks) = (listed, 0);
@@ -271,7 +271,7 @@ fn lookahead_changes_nothing() {
         }
         assert_eq!(plain.particles(), ahead.particles());
         assert_eq!(plain.time().to_bits(), ahead.time().to_bits());
-        // Measured: 98.7 % at N = 10⁵ (tree); a guess right less than half the time is a bug.
+        // The guess is right almost always; right less than half the time, it is a bug.
         assert!(guessed * 2 > pairs, "{kind:?}: {guessed} of {pairs}");
     }
 }

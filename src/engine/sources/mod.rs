@@ -14,7 +14,7 @@
 //! of every source's prediction for it — and a global one for sampling; the
 //! [`ReferenceSimulation`](super::ReferenceSimulation) predicts every source for every
 //! particle after each event. Both take the earliest by [`Event::before`], resolve it through
-//! [`resolve`], and report the [`Outcome`].
+//! `sources::resolve`, and report the [`Outcome`].
 //!
 //! # The total order
 //!
@@ -51,8 +51,8 @@
 //! A file here with its `predict` (a pure function of the states it reads) and its `resolve`
 //! (which changes them); then, in this file only: its variant of [`EventKind`] (the variant's
 //! place is its place among simultaneous events), its words in the queue's slot
-//! ([`EventKind::pack`]), its variant of [`Outcome`] and of [`EventCounts`], and its line in
-//! [`predict_alone`] and [`resolve`]. The queue, the engine's step, the reference, the
+//! (`EventKind::pack`), its variant of [`Outcome`] and of [`EventCounts`], and its line in
+//! `predict_alone` and `resolve`. The queue, the engine's step, the reference, the
 //! observers and the summary take it from there.
 
 pub mod neighbourhood;
@@ -67,7 +67,7 @@ use serde::{Deserialize, Serialize};
 use std::fmt;
 
 /// The most particles an engine takes: indices are 32-bit, the words at and above
-/// `u32::MAX − 3` are the tags of [`EventKind::pack`], and the tournament tree pads the
+/// `u32::MAX − 3` are the tags of the queue's slot words, and the tournament tree pads the
 /// particles with up to two empty slots.
 pub const MAX_PARTICLES: usize = u32::MAX as usize - 4;
 

@@ -1,5 +1,5 @@
 //! The neighbourhood: bookkeeping events that keep every particle's list of candidate
-//! partners complete ([`Neighbours`](crate::engine::neighbours::Neighbours)).
+//! partners complete (`engine/neighbours/`).
 //!
 //! With the cell grid that follows the particles, a particle's candidates are the members of
 //! the cells around its own, so leaving its cell is an event; with neighbour lists, a

@@ -4,8 +4,8 @@
 //! starts. Nothing here changes a result: with every part of it on or off, the events are the
 //! same bit for bit (tested), only the time differs.
 //!
-//! The engine meets it through [`Timing`] alone, at four points: once after the arrays are
-//! built ([`Timing::settle`], shown each large array through [`Visitor`]) and at three places
+//! The engine meets it through [`Timing`] alone, at four points: the store its structures
+//! build their large arrays in ([`Timing::store`]) and three places
 //! in a step — before an event is resolved
 //! ([`Timing::begin`]), between the two predictions that follow a collision
 //! ([`Timing::middle`]) and after them ([`Timing::end`]). It reads the engine's structures
@@ -21,11 +21,43 @@ pub use lookahead::Ahead;
 pub use pages::{collect, filled, huge_page_bytes, moved};
 pub use prefetch::{prefetch, prefetch_address};
 
-use super::arrays::Visitor;
+use super::arrays::{Plain, Store};
 use super::geometry::Particle;
 use super::neighbours::Neighbours;
 use super::params::{EngineParams, Switch};
 use super::queue::EventQueue;
+
+/// The store of [`Timing::store`].
+#[derive(Clone, Copy, Debug)]
+pub(crate) enum Arrays {
+    /// Ordinary vectors.
+    Plain(Plain),
+    /// Huge pages for the arrays large enough.
+    HugePages(pages::HugePages),
+}
+
+impl Store for Arrays {
+    fn collect<T>(&self, items: impl ExactSizeIterator<Item = T>) -> Vec<T> {
+        match self {
+            Arrays::Plain(s) => s.collect(items),
+            Arrays::HugePages(s) => s.collect(items),
+        }
+    }
+
+    fn filled<T: Clone>(&self, n: usize, value: T) -> Vec<T> {
+        match self {
+            Arrays::Plain(s) => s.filled(n, value),
+            Arrays::HugePages(s) => s.filled(n, value),
+        }
+    }
+
+    fn moved<T>(&self, v: Vec<T>) -> Vec<T> {
+        match self {
+            Arrays::Plain(s) => s.moved(v),
+            Arrays::HugePages(s) => s.moved(v),
+        }
+    }
+}
 
 /// What the timing room may read: the engine's structures, as a step leaves them.
 pub(crate) struct Reading<'a, const D: usize> {
@@ -53,11 +85,10 @@ impl Timing {
         Timing { lookahead: params.lookahead.resolve(lookahead::pays(n)), huge_pages: params.huge_pages != Switch::Off }
     }
 
-    /// What moves the engine's large arrays into memory backed by huge pages (elements
-    /// unchanged), before the run touches them: shown every array, it moves those large
-    /// enough (`None`: huge pages are off).
-    pub(crate) fn settle(&self) -> Option<impl Visitor> {
-        self.huge_pages.then_some(pages::Settle)
+    /// Where the engine's structures build their large arrays: in memory backed by huge
+    /// pages (those of 4 MB or more), or in ordinary vectors when huge pages are off.
+    pub(crate) fn store(&self) -> Arrays {
+        if self.huge_pages { Arrays::HugePages(pages::HugePages) } else { Arrays::Plain(Plain) }
     }
 
     /// Before the event of `a` (and `b`, for a pair) is resolved: with the lookahead, the

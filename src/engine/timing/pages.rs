@@ -5,8 +5,8 @@
 //! page walk delays even the lookahead's prefetches. Linux backs memory with 2 MB pages when
 //! asked (`madvise(MADV_HUGEPAGE)` where `/sys/kernel/mm/transparent_hugepage/enabled` is
 //! `madvise`; unasked under `always`). The kernel chooses the page size when a page is first
-//! written, so an array is moved into a new allocation that was advised before the copy
-//! ([`LargeArray::settle`]).
+//! written, so an array is built in an allocation advised before its first element is
+//! written ([`HugePages`], the store the engine's structures are handed).
 //!
 //! The arrays moved are the particles, the neighbour lists and centres, the cells' links and
 //! the tournament tree — about nine tenths of the engine's memory at large N. Where huge
@@ -14,7 +14,7 @@
 //! nothing and the pages stay small: the results are the same bit for bit either way, only
 //! the speed differs.
 
-use crate::engine::arrays::Visitor;
+use crate::engine::arrays::Store;
 
 /// Arrays of fewer bytes keep ordinary pages: a few MB are within the reach of the TLB.
 const FROM_BYTES: usize = 4 << 20;
@@ -22,13 +22,22 @@ const FROM_BYTES: usize = 4 << 20;
 /// The size of a huge page (x86-64 and aarch64 with 4 KB base pages).
 const HUGE: usize = 2 << 20;
 
-/// Moves each array it is shown into memory advised for huge pages, if the array is large
-/// enough for that to matter ([`moved`]).
-pub(crate) struct Settle;
+/// The store that backs the engine's large arrays with huge pages ([`collect`], [`filled`],
+/// [`moved`]).
+#[derive(Clone, Copy, Debug, Default)]
+pub(crate) struct HugePages;
 
-impl Visitor for Settle {
-    fn array<T>(&mut self, v: &mut Vec<T>) {
-        *v = moved(std::mem::take(v));
+impl Store for HugePages {
+    fn collect<T>(&self, items: impl ExactSizeIterator<Item = T>) -> Vec<T> {
+        collect(items)
+    }
+
+    fn filled<T: Clone>(&self, n: usize, value: T) -> Vec<T> {
+        filled(n, value)
+    }
+
+    fn moved<T>(&self, v: Vec<T>) -> Vec<T> {
+        moved(v)
     }
 }
 
