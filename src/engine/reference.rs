@@ -14,7 +14,7 @@
 
 use super::collision::Restitution;
 use super::geometry::{Boundary, Particle, SimBox};
-use super::sources::{self, Event, EventKind, Outcome, pair};
+use super::sources::{self, Event, EventKind, pair};
 
 /// A collision the reference engine processed: `(time, i, j)` for pairs, `(time, i, i)`
 /// for walls.
@@ -94,10 +94,9 @@ impl<const D: usize> ReferenceSimulation<D> {
     fn apply(&mut self, owner: usize, e: Event) -> Collision {
         self.time = e.time;
         let outcome = sources::resolve(&mut self.particles, &self.sim_box, None, Restitution::ELASTIC, owner, &e);
-        match outcome {
-            Outcome::Pair { i, j, .. } => (e.time, i, j),
-            Outcome::Wall { i, .. } => (e.time, i, i),
-            other => unreachable!("the reference predicts only collisions, not {other}"),
+        match outcome.moved() {
+            [Some(i), j] => (e.time, i, j.unwrap_or(i)),
+            _ => unreachable!("the reference predicts only events that move particles, not {outcome}"),
         }
     }
 }

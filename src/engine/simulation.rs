@@ -158,15 +158,7 @@ impl<const D: usize> Simulation<D> {
             return bad(format!("particle {i} was last updated at {}, after the clock ({})", p.time, state.time));
         }
         for (owner, p) in state.pending.iter().enumerate() {
-            let fine = match p.kind {
-                EventKind::Pair { partner, .. } => (partner as usize) < n && partner as usize != owner,
-                EventKind::Wall { axis, .. } => {
-                    (axis as usize) < D && sim_box.boundary[axis as usize] == Boundary::Wall
-                }
-                EventKind::Rebuild | EventKind::Nothing => true,
-                // A global event is no particle's.
-                EventKind::Sample => false,
-            };
+            let fine = p.kind.fits(owner, n, &sim_box);
             // Every pending event is predicted no earlier than the clock at its prediction,
             // and the clock is the time of the earliest: none is ever in the past.
             if !fine || p.time.is_nan() || p.time < state.time {
@@ -510,11 +502,7 @@ impl<const D: usize> Simulation<D> {
     /// exact); only re-prediction markers go.
     #[inline]
     fn wrapped(&self, outcome: &Outcome<D>) -> bool {
-        match *outcome {
-            Outcome::Pair { i, j, .. } => self.particles[i].events == 0 || self.particles[j].events == 0,
-            Outcome::Wall { i, .. } => self.particles[i].events == 0,
-            Outcome::Rebuild { .. } | Outcome::Sample => false,
-        }
+        outcome.moved().iter().flatten().any(|&i| self.particles[i].events == 0)
     }
 
     /// Predicts particle `i`'s earliest event — from every source that concerns it alone, and

@@ -13,7 +13,8 @@
 //! # Adding an experiment
 //!
 //! Its file here, with `NAME` and `run(&Options)`; then its line in [`EXPERIMENTS`] below
-//! (and `pub mod`). A binary of its own is one more `[[bin]]` entry in Cargo.toml.
+//! (and `pub mod`): `collide experiment <name>` and `collide validate` then run it. A binary of
+//! its own, if wanted, is a three-line `src/bin/<name>.rs` calling [`main_for`].
 
 pub mod check;
 pub mod collision_rate;

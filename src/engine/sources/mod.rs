@@ -51,9 +51,12 @@
 //! A file here with its `predict` (a pure function of the states it reads) and its `resolve`
 //! (which changes them); then, in this file only: its variant of [`EventKind`] (the variant's
 //! place is its place among simultaneous events), its words in the queue's slot
-//! (`EventKind::pack`), its variant of [`Outcome`] and of [`EventCounts`], and its line in
-//! `predict_alone` and `resolve`. The queue, the engine's step, the reference, the
-//! observers and the summary take it from there.
+//! (`EventKind::pack`), where a restored one may stand (`EventKind::fits`), its variant of
+//! [`Outcome`] with the particles it moved ([`Outcome::moved`]) and of [`EventCounts`], and
+//! its line in `predict_alone` and `resolve`. The queue, the engine's step, the reference
+//! and the summary take it from there. The thermodynamic observer's match over outcomes is
+//! exhaustive on purpose: the compiler asks how the new source's momentum enters the
+//! pressure (nothing, for a source that exchanges none with the outside).
 
 pub mod neighbourhood;
 pub mod pair;
@@ -61,7 +64,7 @@ pub mod sample;
 pub mod wall;
 
 use super::collision::{Impulse, Restitution};
-use super::geometry::{Particle, SimBox};
+use super::geometry::{Boundary, Particle, SimBox};
 use super::neighbours::Neighbours;
 use serde::{Deserialize, Serialize};
 use std::fmt;
@@ -219,6 +222,20 @@ impl Event {
     }
 }
 
+impl EventKind {
+    /// Whether this kind can be the pending event of particle `owner` of `n` in `sim_box`
+    /// (the check of a restored state): a partner in range and not itself, a wall the box
+    /// has. A global event is no particle's.
+    pub(crate) fn fits<const D: usize>(&self, owner: usize, n: usize, sim_box: &SimBox<D>) -> bool {
+        match *self {
+            EventKind::Pair { partner, .. } => (partner as usize) < n && partner as usize != owner,
+            EventKind::Wall { axis, .. } => (axis as usize) < D && sim_box.boundary[axis as usize] == Boundary::Wall,
+            EventKind::Rebuild | EventKind::Nothing => true,
+            EventKind::Sample => false,
+        }
+    }
+}
+
 /// What one resolved event did (what the observers are fed).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub enum Outcome<const D: usize> {
@@ -250,6 +267,19 @@ pub enum Outcome<const D: usize> {
     },
     /// A scheduled sampling time was reached.
     Sample,
+}
+
+impl<const D: usize> Outcome<D> {
+    /// The particles whose motion the event changed, lower first: both of a pair, the one
+    /// of a wall; none for bookkeeping (a neighbourhood update, a sample).
+    #[inline]
+    pub fn moved(&self) -> [Option<usize>; 2] {
+        match *self {
+            Outcome::Pair { i, j, .. } => [Some(i), Some(j)],
+            Outcome::Wall { i, .. } => [Some(i), None],
+            Outcome::Rebuild { .. } | Outcome::Sample => [None, None],
+        }
+    }
 }
 
 impl<const D: usize> fmt::Display for Outcome<D> {
@@ -404,6 +434,35 @@ mod extended_float {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use nalgebra::SVector;
+
+    /// What an event moved is what the event and its outcome say it involves: the
+    /// counter-wrap check and the reference read it, so a wrong answer would skip a
+    /// re-prediction or report a collision with the wrong particles.
+    #[test]
+    fn an_outcome_names_the_particles_it_moved() {
+        let impulse = Impulse { on_second: SVector::<f64, 2>::zeros(), normal: SVector::zeros() };
+        assert_eq!(Outcome::Pair { i: 3, j: 7, impulse }.moved(), [Some(3), Some(7)]);
+        assert_eq!(Outcome::<2>::Wall { i: 5, axis: 1, upper: false, impulse: 1.0 }.moved(), [Some(5), None]);
+        assert_eq!(Outcome::<2>::Rebuild { i: 5 }.moved(), [None, None]);
+        assert_eq!(Outcome::<2>::Sample.moved(), [None, None]);
+    }
+
+    /// A restored pending event must be one the particle can have.
+    #[test]
+    fn a_restored_event_fits_its_particle_and_box() {
+        let walled =
+            SimBox::<2> { lengths: SVector::from([10.0, 10.0]), boundary: [Boundary::Wall, Boundary::Periodic] };
+        let pair = |partner| EventKind::Pair { partner, partner_events: 0 };
+        assert!(pair(4).fits(3, 5, &walled));
+        assert!(!pair(5).fits(3, 5, &walled), "a partner out of range");
+        assert!(!pair(3).fits(3, 5, &walled), "a particle is not its own partner");
+        assert!(EventKind::Wall { axis: 0, upper: true }.fits(0, 5, &walled));
+        assert!(!EventKind::Wall { axis: 1, upper: true }.fits(0, 5, &walled), "a periodic axis has no wall");
+        assert!(!EventKind::Wall { axis: 2, upper: true }.fits(0, 5, &walled), "no third axis in 2D");
+        assert!(EventKind::Rebuild.fits(0, 5, &walled) && EventKind::Nothing.fits(0, 5, &walled));
+        assert!(!EventKind::Sample.fits(0, 5, &walled), "a global event is no particle's");
+    }
 
     /// Every kind of event comes back out of its two words as it went in, at the extremes
     /// of every field.
