@@ -3,9 +3,12 @@
 //! experiments come later; here every piece is driven through the library.)
 
 use collide::engine::init::{InitError, Placement, Species, Velocities, box_for_packing_fraction, initial_particles};
-use collide::engine::{Boundary, Outcome, ReferenceSimulation, Simulation};
+use collide::engine::{Boundary, ReferenceSimulation, Simulation};
 use collide::run::output::xyz_frame;
 use collide::run::{Checkpoint, Config, Discard, Run, RunError, Summary};
+
+mod common;
+use common::assert_same_collisions;
 
 const EPS: f64 = f64::EPSILON;
 
@@ -73,19 +76,9 @@ fn spheres_collide_as_the_reference_says() {
         let sim_box = box_for_packing_fraction::<3>(&species, 0.2, boundary, Placement::Random, None);
         let particles =
             initial_particles(&species, &sim_box, Placement::Random, Velocities::Maxwell, 1.0, seed).unwrap();
-        let mut fast = Simulation::new(particles.clone(), sim_box).unwrap();
-        let mut slow = ReferenceSimulation::new(particles, sim_box);
-        for k in 0..3000 {
-            let expected = slow.step().expect("a collision");
-            let got = loop {
-                match fast.step().expect("an event") {
-                    Outcome::Pair { i, j, .. } => break (fast.time(), i, j),
-                    Outcome::Wall { i, .. } => break (fast.time(), i, i),
-                    _ => continue,
-                }
-            };
-            assert_eq!((got.0.to_bits(), got.1, got.2), (expected.0.to_bits(), expected.1, expected.2), "{k}");
-        }
+        let fast = Simulation::new(particles.clone(), sim_box).unwrap();
+        let slow = ReferenceSimulation::new(particles, sim_box);
+        assert_same_collisions(fast, slow, 3000, &format!("{boundary:?}, seed {seed}"));
     }
 }
 

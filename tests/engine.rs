@@ -4,6 +4,9 @@ use collide::engine::init::{Placement, Species, Velocities, box_for_packing_frac
 use collide::engine::{Boundary, Neighbourhood, Outcome, Particle, ReferenceSimulation, SimBox, Simulation};
 use nalgebra::Vector2;
 
+mod common;
+use common::assert_same_collisions;
+
 fn disk(x: f64, y: f64, vx: f64, vy: f64, radius: f64, mass: f64) -> Particle<2> {
     Particle {
         position: Vector2::new(x, y),
@@ -92,25 +95,6 @@ fn random_system(
     let sim_box = box_for_packing_fraction(&species, eta, boundary, placement, None);
     let particles = initial_particles(&species, &sim_box, placement, Velocities::Maxwell, 1.0, seed).unwrap();
     (particles, sim_box)
-}
-
-/// Runs both engines for `n` collisions and requires identical (time bits, i, j).
-fn assert_same_collisions(mut fast: Simulation<2>, mut slow: ReferenceSimulation<2>, n: usize, label: &str) {
-    for k in 0..n {
-        let expected = slow.step().expect("a collision");
-        let got = loop {
-            match fast.step().expect("an event") {
-                Outcome::Pair { i, j, .. } => break (fast.time(), i, j),
-                Outcome::Wall { i, .. } => break (fast.time(), i, i),
-                _ => continue,
-            }
-        };
-        assert_eq!(
-            (got.0.to_bits(), got.1, got.2),
-            (expected.0.to_bits(), expected.1, expected.2),
-            "{label}, collision {k}: fast {got:?}, reference {expected:?}"
-        );
-    }
 }
 
 /// The fast engine (queue, cells, invalidation) and the O(N²) reference produce the same

@@ -94,9 +94,9 @@ impl<const D: usize> ReferenceSimulation<D> {
     fn apply(&mut self, owner: usize, e: Event) -> Collision {
         self.time = e.time;
         let outcome = sources::resolve(&mut self.particles, &self.sim_box, None, Restitution::ELASTIC, owner, &e);
-        match outcome.moved() {
-            [Some(i), j] => (e.time, i, j.unwrap_or(i)),
-            _ => unreachable!("the reference predicts only events that move particles, not {outcome}"),
-        }
+        let Some((i, j)) = outcome.collided() else {
+            unreachable!("the reference predicts only events that move particles, not {outcome}")
+        };
+        (e.time, i, j)
     }
 }

@@ -502,7 +502,7 @@ impl<const D: usize> Simulation<D> {
     /// exact); only re-prediction markers go.
     #[inline]
     fn wrapped(&self, outcome: &Outcome<D>) -> bool {
-        outcome.moved().iter().flatten().any(|&i| self.particles[i].events == 0)
+        outcome.collided().is_some_and(|(i, j)| self.particles[i].events == 0 || self.particles[j].events == 0)
     }
 
     /// Predicts particle `i`'s earliest event — from every source that concerns it alone, and

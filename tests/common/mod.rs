@@ -1,6 +1,8 @@
-//! What the tests of the command line and of bad input share: the small run they start
-//! from, and what strict JSON is.
+//! What the integration tests share: the small run the command-line and bad-input tests
+//! start from, what strict JSON is, and the engine held against the reference.
 #![allow(dead_code)]
+
+use collide::engine::{ReferenceSimulation, Simulation};
 
 /// A small mixture with walls along y, a trajectory and periodic checkpoints, that runs in
 /// a fraction of a second; the tests edit it.
@@ -41,4 +43,27 @@ pub fn strict_json(text: &str) -> bool {
         }
     }
     serde_json::from_str::<serde_json::Value>(text).is_ok_and(|v| finite(&v))
+}
+
+/// Runs both engines for `n` collisions and requires identical (time bits, i, j); the fast
+/// engine's bookkeeping events (neighbourhood updates, samples) are passed over.
+pub fn assert_same_collisions<const D: usize>(
+    mut fast: Simulation<D>,
+    mut slow: ReferenceSimulation<D>,
+    n: usize,
+    label: &str,
+) {
+    for k in 0..n {
+        let expected = slow.step().expect("a collision");
+        let got = loop {
+            if let Some((i, j)) = fast.step().expect("an event").collided() {
+                break (fast.time(), i, j);
+            }
+        };
+        assert_eq!(
+            (got.0.to_bits(), got.1, got.2),
+            (expected.0.to_bits(), expected.1, expected.2),
+            "{label}, collision {k}: fast {got:?}, reference {expected:?}"
+        );
+    }
 }

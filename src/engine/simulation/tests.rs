@@ -106,10 +106,8 @@ fn collisions(
 ) -> Vec<(u64, usize, usize)> {
     let mut out = Vec::with_capacity(count);
     while out.len() < count {
-        match sim.step().expect("a live gas") {
-            Outcome::Pair { i, j, .. } => out.push((sim.time().to_bits(), i, j)),
-            Outcome::Wall { i, .. } => out.push((sim.time().to_bits(), i, i)),
-            _ => {}
+        if let Some((i, j)) = sim.step().expect("a live gas").collided() {
+            out.push((sim.time().to_bits(), i, j));
         }
         between(sim);
     }
@@ -190,11 +188,7 @@ fn wrapping_event_counters_change_nothing() {
     wrapping.predict_everyone();
     let (mut plain, mut wraps) = (plain, 0);
     for _ in 0..20_000 {
-        let collision = |o: Option<Outcome<2>>| match o {
-            Some(Outcome::Pair { i, j, .. }) => Some((i, j)),
-            Some(Outcome::Wall { i, .. }) => Some((i, i)),
-            _ => None,
-        };
+        let collision = |o: Option<Outcome<2>>| o.and_then(|o| o.collided());
         let expected = loop {
             if let Some(c) = collision(plain.step()) {
                 break (c, plain.time().to_bits());

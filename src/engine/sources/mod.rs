@@ -52,7 +52,7 @@
 //! (which changes them); then, in this file only: its variant of [`EventKind`] (the variant's
 //! place is its place among simultaneous events), its words in the queue's slot
 //! (`EventKind::pack`), where a restored one may stand (`EventKind::fits`), its variant of
-//! [`Outcome`] with the particles it moved ([`Outcome::moved`]) and of [`EventCounts`], and
+//! [`Outcome`] with the particles it moved ([`Outcome::collided`]) and of [`EventCounts`], and
 //! its line in `predict_alone` and `resolve`. The queue, the engine's step, the reference
 //! and the summary take it from there. The thermodynamic observer's match over outcomes is
 //! exhaustive on purpose: the compiler asks how the new source's momentum enters the
@@ -270,14 +270,16 @@ pub enum Outcome<const D: usize> {
 }
 
 impl<const D: usize> Outcome<D> {
-    /// The particles whose motion the event changed, lower first: both of a pair, the one
-    /// of a wall; none for bookkeeping (a neighbourhood update, a sample).
+    /// The particles whose motion the event changed, as a collision: `(i, j)`, `i < j`, for
+    /// a pair, `(i, i)` for a particle alone (a wall); `None` for bookkeeping (a
+    /// neighbourhood update, a sample). The reference engine reports its collisions so, and
+    /// the engine checks these particles' counters for a wrap.
     #[inline]
-    pub fn moved(&self) -> [Option<usize>; 2] {
+    pub fn collided(&self) -> Option<(usize, usize)> {
         match *self {
-            Outcome::Pair { i, j, .. } => [Some(i), Some(j)],
-            Outcome::Wall { i, .. } => [Some(i), None],
-            Outcome::Rebuild { .. } | Outcome::Sample => [None, None],
+            Outcome::Pair { i, j, .. } => Some((i, j)),
+            Outcome::Wall { i, .. } => Some((i, i)),
+            Outcome::Rebuild { .. } | Outcome::Sample => None,
         }
     }
 }
@@ -442,10 +444,10 @@ mod tests {
     #[test]
     fn an_outcome_names_the_particles_it_moved() {
         let impulse = Impulse { on_second: SVector::<f64, 2>::zeros(), normal: SVector::zeros() };
-        assert_eq!(Outcome::Pair { i: 3, j: 7, impulse }.moved(), [Some(3), Some(7)]);
-        assert_eq!(Outcome::<2>::Wall { i: 5, axis: 1, upper: false, impulse: 1.0 }.moved(), [Some(5), None]);
-        assert_eq!(Outcome::<2>::Rebuild { i: 5 }.moved(), [None, None]);
-        assert_eq!(Outcome::<2>::Sample.moved(), [None, None]);
+        assert_eq!(Outcome::Pair { i: 3, j: 7, impulse }.collided(), Some((3, 7)));
+        assert_eq!(Outcome::<2>::Wall { i: 5, axis: 1, upper: false, impulse: 1.0 }.collided(), Some((5, 5)));
+        assert_eq!(Outcome::<2>::Rebuild { i: 5 }.collided(), None);
+        assert_eq!(Outcome::<2>::Sample.collided(), None);
     }
 
     /// A restored pending event must be one the particle can have.
