@@ -167,6 +167,11 @@ impl ExperimentResult {
 
     /// The experiment's own directory under `out`, created for its plots.
     pub fn plot_dir(out: &Path, name: &str) -> Result<PathBuf, ExperimentError> {
+        Ok(ExperimentResult::made_dir(out, name)?)
+    }
+
+    /// The experiment's own directory under `out`, created.
+    fn made_dir(out: &Path, name: &str) -> Result<PathBuf, OutputError> {
         let dir = ExperimentResult::dir(out, name);
         std::fs::create_dir_all(&dir).map_err(crate::run::rundir::at(&dir))?;
         Ok(dir)
@@ -174,8 +179,7 @@ impl ExperimentResult {
 
     /// Writes `result.json` (atomically) into the experiment's directory.
     pub fn write(&self, out: &Path) -> Result<(), OutputError> {
-        let dir = ExperimentResult::dir(out, &self.name);
-        std::fs::create_dir_all(&dir).map_err(crate::run::rundir::at(&dir))?;
+        let dir = ExperimentResult::made_dir(out, &self.name)?;
         let text = serde_json::to_string_pretty(self).expect("results serialise");
         write_atomic(&dir.join("result.json"), text.as_bytes())
     }

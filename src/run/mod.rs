@@ -62,6 +62,9 @@ pub enum RunError {
     },
     /// The initial state is not a valid configuration (overlap, box too small, …).
     Setup(SetupError),
+    /// The particles handed to [`Run::from_particles`] are not those of the configuration's
+    /// species (count, radius or mass).
+    Particles(StateError),
     /// A checkpoint that cannot be continued.
     Checkpoint(CheckpointError),
 }
@@ -78,6 +81,7 @@ impl fmt::Display for RunError {
                 "initial state: {error}: the lattice's sites are closer than the largest contact distance; a triangular lattice holds these species up to η ≈ {fits_up_to:.4}"
             ),
             RunError::Setup(e) => write!(f, "initial state: {e}"),
+            RunError::Particles(e) => write!(f, "the particles given: {e}"),
             RunError::Checkpoint(e) => write!(f, "{e}"),
         }
     }
@@ -301,7 +305,7 @@ impl<const D: usize> Run<D> {
     pub fn from_particles(config: Config, particles: Vec<Particle<D>>) -> Result<Run<D>, RunError> {
         let limits = Limits::for_this_machine();
         let (sim_box, estimate) = admit::<D>(&config, &limits)?;
-        check_particles(&config, &particles).map_err(|e| RunError::Checkpoint(CheckpointError::State(e)))?;
+        check_particles(&config, &particles).map_err(RunError::Particles)?;
         let sim = Simulation::new(particles, sim_box).map_err(RunError::Setup)?;
         Ok(Run::started(config, sim, limits, estimate))
     }
@@ -622,5 +626,35 @@ impl<const D: usize> Run<D> {
             }
         }
         Ok(None)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::engine::init::{Velocities, initial_particles};
+
+    /// An experiment's own particles must be those of its configuration's species; a count
+    /// or a radius off is refused as the particles' fault, naming what differs.
+    #[test]
+    fn particles_handed_in_must_be_the_species() {
+        let config = Config::default_config();
+        let sim_box = box_of::<2>(&config);
+        let particles =
+            initial_particles(&config.species, &sim_box, Placement::Triangular, Velocities::Maxwell, 1.0, 1).unwrap();
+        assert!(Run::<2>::from_particles(config.clone(), particles.clone()).is_ok());
+
+        let fewer = particles[1..].to_vec();
+        let Err(RunError::Particles(e)) = Run::<2>::from_particles(config.clone(), fewer) else {
+            panic!("one particle short is refused")
+        };
+        assert!(e.found.contains("999 particles"), "{e}");
+
+        let mut other = particles;
+        other[7].radius *= 0.9;
+        let Err(RunError::Particles(e)) = Run::<2>::from_particles(config, other) else {
+            panic!("a particle of another radius is refused")
+        };
+        assert!(e.found.contains("particle 7"), "{e}");
     }
 }
