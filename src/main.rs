@@ -384,7 +384,7 @@ fn contact(args: ContactArgs) -> Result<ExitCode> {
 
 fn run_simulation(args: RunArgs) -> Result<ExitCode> {
     use collide::run::config::{Config, DEFAULT_CONFIG};
-    use collide::run::output::{RunFailure, RunOptions, Start, load_checkpoint, run_into};
+    use collide::run::output::{AnyCheckpoint, RunFailure, RunOptions, Start, load_any_checkpoint, run_into};
     use collide::run::{Phase, Status};
     use std::sync::Arc;
     use std::sync::atomic::AtomicBool;
@@ -418,17 +418,32 @@ fn run_simulation(args: RunArgs) -> Result<ExitCode> {
     for signal in [signal_hook::consts::SIGINT, signal_hook::consts::SIGTERM] {
         signal_hook::flag::register(signal, Arc::clone(&stop)).context("installing the signal handlers")?;
     }
-    let (start, source) = if let Some(path) = &args.resume {
-        let checkpoint = load_checkpoint::<2>(path).map_err(|e| anyhow::anyhow!("{}: {e}", path.display()))?;
-        (Start::Resume { checkpoint, path }, path.display().to_string())
-    } else {
-        match &args.config {
-            Some(path) => (Start::Fresh(Config::load(path)?), path.display().to_string()),
-            None => (Start::Fresh(Config::default_config()), "the embedded default".to_string()),
-        }
-    };
     let options = RunOptions { force: args.force, interrupt_after: args.interrupt_after };
-    let summary = run_into::<2>(start, &args.out, options, &stop, progress).map_err(|e| match e {
+    // The run's dimension decides the engine's: a configuration's `dimension`, or that of the
+    // run a checkpoint holds.
+    let (summary, source) = if let Some(path) = &args.resume {
+        let source = path.display().to_string();
+        let summary = match load_any_checkpoint(path).map_err(|e| anyhow::anyhow!("{source}: {e}"))? {
+            AnyCheckpoint::Disks(checkpoint) => {
+                run_into::<2>(Start::Resume { checkpoint, path }, &args.out, options, &stop, progress)
+            }
+            AnyCheckpoint::Spheres(checkpoint) => {
+                run_into::<3>(Start::Resume { checkpoint, path }, &args.out, options, &stop, progress)
+            }
+        };
+        (summary, source)
+    } else {
+        let (config, source) = match &args.config {
+            Some(path) => (Config::load(path)?, path.display().to_string()),
+            None => (Config::default_config(), "the embedded default".to_string()),
+        };
+        let summary = match config.dimension {
+            3 => run_into::<3>(Start::Fresh(config), &args.out, options, &stop, progress),
+            _ => run_into::<2>(Start::Fresh(config), &args.out, options, &stop, progress),
+        };
+        (summary, source)
+    };
+    let summary = summary.map_err(|e| match e {
         // A bad configuration, initial state or checkpoint: name where it came from.
         RunFailure::Run(e) => anyhow::anyhow!("{source}: {e}"),
         RunFailure::Output(e) => anyhow::anyhow!("{e}"),

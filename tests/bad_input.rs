@@ -40,7 +40,8 @@ struct Case {
     config_bytes: Option<Vec<u8>>,
     /// A value that repeats to make a long configuration value: `[placeholder, char, n]`.
     long: Option<(String, String, usize)>,
-    /// Edits of the base checkpoint: `[JSON pointer, JSON value]`.
+    /// Edits of the base checkpoint: `[JSON pointer, JSON value]` (a key missing from its
+    /// object is added).
     checkpoint_edit: Vec<[String; 2]>,
     /// Entries removed from the base checkpoint (JSON pointers into arrays or objects).
     checkpoint_remove: Vec<String>,
@@ -140,7 +141,14 @@ fn checkpoint_for(case: &Case, dir: &Path) -> PathBuf {
     for [pointer, new] in &case.checkpoint_edit {
         let pointer = &pointer.replace("@latest", &latest.to_string());
         let new: serde_json::Value = serde_json::from_str(new).unwrap_or_else(|e| panic!("{}: {new}: {e}", case.name));
-        *value.pointer_mut(pointer).unwrap_or_else(|| panic!("{}: no {pointer}", case.name)) = new;
+        match value.pointer_mut(pointer) {
+            Some(old) => *old = new,
+            // A key the writer leaves out (a default): added to its object.
+            None => match pointer_parent(&mut value, pointer) {
+                (serde_json::Value::Object(map), key) => drop(map.insert(key, new)),
+                _ => panic!("{}: no {pointer}", case.name),
+            },
+        }
     }
     for pointer in &case.checkpoint_remove {
         let (parent, key) = pointer_parent(&mut value, pointer);

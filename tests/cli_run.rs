@@ -155,6 +155,43 @@ fn an_interrupted_run_resumes_to_the_files_of_an_uninterrupted_one() {
     no_temporary_files(&part);
 }
 
+/// Spheres through the command line: `dimension = 3` runs the 3D engine from an fcc
+/// crystal with walls along z; summary.json says `"dimension": 3` and the box has three
+/// edges; the trajectory has real z; interrupted and resumed (the checkpoint names its
+/// dimension), it ends with the files of the run never interrupted.
+#[test]
+fn spheres_run_and_resume_from_the_command_line() {
+    let dir = scratch("run-spheres");
+    let config = dir.join("spheres.toml");
+    let text = BASE
+        .replace("seed = 3", "dimension = 3\nseed = 3")
+        .replace(r#"boundary = ["periodic", "wall"]"#, r#"boundary = ["periodic", "periodic", "wall"]"#)
+        .replace(r#"placement = "square""#, r#"placement = "fcc""#);
+    std::fs::write(&config, text).unwrap();
+    let (whole, part) = (dir.join("whole"), dir.join("part"));
+    let run = collide(&["run", config.to_str().unwrap(), "--out", whole.to_str().unwrap()]);
+    assert!(run.status.success(), "{}", String::from_utf8_lossy(&run.stderr));
+    let s = json(&whole.join("summary.json"));
+    assert_eq!(s["dimension"], 3);
+    assert_eq!(s["box_lengths"].as_array().unwrap().len(), 3);
+    assert_eq!(s["config"]["dimension"], 3);
+    let axes: Vec<u64> = s["wall_pressures"].as_array().unwrap().iter().map(|w| w["axis"].as_u64().unwrap()).collect();
+    assert_eq!(axes, [2, 2]);
+    assert!(s["compressibility"].as_f64().unwrap() > 1.0);
+    assert!(s["max_overlap"]["fraction"].as_f64().unwrap() <= 1e-12);
+    let xyz = std::fs::read_to_string(whole.join("trajectory.xyz")).unwrap();
+    let z: Vec<f64> =
+        xyz.lines().skip(2).take(100).map(|l| l.split_whitespace().nth(3).unwrap().parse().unwrap()).collect();
+    assert!(z.iter().any(|&z| z != z.round()) && z.iter().any(|&z| z > 1.0), "real z: {z:?}");
+    let stopped =
+        collide(&["run", config.to_str().unwrap(), "--out", part.to_str().unwrap(), "--interrupt-after", "7000"]);
+    assert_eq!(stopped.status.code(), Some(130), "{}", String::from_utf8_lossy(&stopped.stderr));
+    let ck = part.join("checkpoint.json");
+    let resumed = collide(&["run", "--resume", ck.to_str().unwrap(), "--out", part.to_str().unwrap()]);
+    assert!(resumed.status.success(), "{}", String::from_utf8_lossy(&resumed.stderr));
+    same_results(&whole, &part);
+}
+
 /// The process ids of signals sent in the tests below come from `Child::id`.
 fn signal(child: &std::process::Child, signal: i32) {
     // SAFETY: kill(2) on a child of this process, which has not been waited for.

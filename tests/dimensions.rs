@@ -14,14 +14,14 @@ const EPS: f64 = f64::EPSILON;
 
 fn spheres(n: usize, eta: f64, boundary: &str, collisions: u64, seed: u64) -> Config {
     let text = format!(
-        "seed = {seed}\n[box]\npacking_fraction = {eta}\nboundary = {boundary}\n\
+        "dimension = 3\nseed = {seed}\n[box]\npacking_fraction = {eta}\nboundary = {boundary}\n\
          [[species]]\ncount = {}\nradius = 0.5\nmass = 1.0\n[[species]]\ncount = {}\nradius = 0.4\nmass = 0.6\n\
          [init]\nplacement = \"random\"\n[equilibration]\ncollisions = 5000\n\
          [run]\ncollisions = {collisions}\nsample_interval = 0.5\n",
         n / 2,
         n - n / 2
     );
-    Config::parse_for(&text, "spheres", 3).unwrap()
+    Config::parse(&text, "spheres").unwrap()
 }
 
 fn reproducible(summary: Summary) -> Summary {
@@ -82,6 +82,29 @@ fn spheres_collide_as_the_reference_says() {
     }
 }
 
+/// Dense crystals from fcc (and a simple cubic lattice between walls): the fast engine and
+/// the reference agree to the bit from a perfect fcc crystal near close packing (η = 0.70,
+/// 108 spheres, periodic), from one with vacancies between walls, and from a simple cubic
+/// lattice in a mixed box.
+#[test]
+fn dense_lattice_starts_collide_as_the_reference_says() {
+    use Boundary::{Periodic as P, Wall as W};
+    let cases = [
+        (108, 0.70, [P; 3], Placement::Fcc, 3),
+        (100, 0.55, [W; 3], Placement::Fcc, 4),
+        (125, 0.45, [P, W, P], Placement::SimpleCubic, 5),
+    ];
+    for (n, eta, boundary, placement, seed) in cases {
+        let species = vec![Species { count: n, radius: 0.5, mass: 1.0 }];
+        let sim_box = box_for_packing_fraction::<3>(&species, eta, boundary, placement, None);
+        let particles = initial_particles(&species, &sim_box, placement, Velocities::Maxwell, 1.0, seed).unwrap();
+        let fast = Simulation::new(particles.clone(), sim_box).unwrap();
+        assert_eq!(fast.check_overlaps().at, None);
+        let slow = ReferenceSimulation::new(particles, sim_box);
+        assert_same_collisions(fast, slow, 4000, &format!("{placement:?} η = {eta} {boundary:?}"));
+    }
+}
+
 /// Initial states in 3D: random placement without overlap, one speed per species with
 /// fixed-speed velocities (walls: no momentum removed), the temperature exact; the 2D
 /// lattices refused with the way out.
@@ -103,17 +126,15 @@ fn initial_states_in_three_dimensions() {
     for placement in [Placement::Triangular, Placement::Square] {
         let err = initial_particles(&species, &sim_box, placement, Velocities::Maxwell, 1.0, 1).unwrap_err();
         assert_eq!(err, InitError::NotInDimension { placement, dimension: 3 });
-        assert!(err.to_string().contains("is a 2D lattice; in 3D use placement = \"random\""), "{err}");
+        assert!(err.to_string().contains("is not a lattice of 3D; use placement = \"fcc\""), "{err}");
     }
-    let config = Config::parse_for(
-        "seed = 1\n[box]\npacking_fraction = 0.3\nboundary = \"periodic\"\n[[species]]\ncount = 50\nradius = 0.5\nmass = 1.0\n[run]\ncollisions = 10\n",
+    let config = Config::parse(
+        "dimension = 3\nseed = 1\n[box]\npacking_fraction = 0.3\nboundary = \"periodic\"\n[[species]]\ncount = 50\nradius = 0.5\nmass = 1.0\n[run]\ncollisions = 10\n",
         "lattice",
-        3,
     )
     .unwrap();
-    let Err(RunError::Init(InitError::NotInDimension { .. })) = Run::<3>::new(config) else {
-        panic!("the default triangular lattice is 2D only")
-    };
+    assert_eq!(config.placement(), Placement::Fcc, "the densest lattice by default");
+    let Err(RunError::Config(_)) = Run::<2>::new(config) else { panic!("a 3D configuration in a 2D run") };
 }
 
 /// Extended XYZ in 3D: real z coordinates inside the box, the third edge in the lattice, the

@@ -161,6 +161,30 @@ fn digest<const D: usize>(version: &str, run: &Saved<D>) -> String {
     hex
 }
 
+/// The dimension of the run a checkpoint's text holds (`run.config.dimension`, 2 when
+/// absent), read without building its state: the caller then reads it as a
+/// [`Checkpoint<D>`] of that dimension. Text that is not a checkpoint says 2, and reading it
+/// then says what is wrong with it.
+pub fn dimension_of(bytes: &[u8]) -> usize {
+    #[derive(Deserialize)]
+    struct Outer {
+        run: Inner,
+    }
+    #[derive(Deserialize)]
+    struct Inner {
+        config: Dimension,
+    }
+    #[derive(Deserialize)]
+    struct Dimension {
+        #[serde(default = "two")]
+        dimension: usize,
+    }
+    fn two() -> usize {
+        2
+    }
+    serde_json::from_slice::<Outer>(bytes).map_or(2, |outer| outer.run.config.dimension)
+}
+
 impl<const D: usize> Checkpoint<D> {
     /// Seals a saved state with this version and its digest.
     pub fn seal(run: Saved<D>) -> Checkpoint<D> {

@@ -47,6 +47,10 @@ blocks = 20
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct Config {
+    /// 2 (disks) or 3 (spheres); 2 when absent (and then not written back, so that a 2D
+    /// configuration echoes as it was read).
+    #[serde(default = "two", skip_serializing_if = "is_two")]
+    pub dimension: usize,
     /// Seed of the portable random generator (Xoshiro256++) for the initial state.
     pub seed: u64,
     /// The box.
@@ -68,6 +72,43 @@ pub struct Config {
     /// Observables measured besides the thermodynamics (`[observe.<name>]`).
     #[serde(default, skip_serializing_if = "Selection::is_empty")]
     pub observe: Selection,
+}
+
+fn two() -> usize {
+    2
+}
+
+fn is_two(d: &usize) -> bool {
+    *d == 2
+}
+
+/// The shape of a box made from a packing fraction.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(untagged)]
+pub enum Aspect {
+    /// `Ly/Lx`, every other edge equal to `Lx`.
+    Ratio(f64),
+    /// The edges' proportions `[Lx, Ly(, Lz)]`, one per axis (any scale).
+    Edges(Vec<f64>),
+}
+
+impl Aspect {
+    /// The edges' proportions in `D` dimensions, `Lx`'s entry first (checked for `D`).
+    pub fn edges<const D: usize>(&self) -> [f64; D] {
+        match self {
+            Aspect::Ratio(r) => std::array::from_fn(|a| if a == 1 { *r } else { 1.0 }),
+            Aspect::Edges(e) => std::array::from_fn(|a| e[a]),
+        }
+    }
+}
+
+impl fmt::Display for Aspect {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self {
+            Aspect::Ratio(r) => write!(f, "{}", num(*r)),
+            Aspect::Edges(e) => write!(f, "[{}]", e.iter().map(|&x| num(x)).collect::<Vec<_>>().join(", ")),
+        }
+    }
 }
 
 /// Boundaries: one for all axes, or one per axis.
@@ -119,23 +160,27 @@ impl<'de> Deserialize<'de> for Boundaries {
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct BoxConfig {
-    /// Edge lengths `[Lx, Ly]`.
+    /// Edge lengths `[Lx, Ly]` or `[Lx, Ly, Lz]`.
     pub size: Option<Vec<f64>>,
-    /// Packing fraction η = Σπ Rᵢ² / A.
+    /// Packing fraction η = Σ V(Rᵢ) / V_box (V(R) = πR² for disks, 4πR³/3 for spheres).
     pub packing_fraction: Option<f64>,
-    /// Ly/Lx when the size comes from the packing fraction (default 1; a periodic triangular
-    /// lattice uses its own aspect ratio instead).
-    pub aspect: Option<f64>,
+    /// The box's shape when its size comes from the packing fraction: `Ly/Lx`, or the
+    /// proportions of the edges, one per axis (default a square or cube; a periodic
+    /// triangular lattice uses its own aspect ratio instead).
+    pub aspect: Option<Aspect>,
     /// "periodic", "wall", or one per axis.
     pub boundary: Boundaries,
 }
 
-/// The initial state (each field optional: triangular, maxwell, kT = 1).
+/// The initial state (each field optional: the densest lattice of the dimension —
+/// triangular or fcc —, maxwell, kT = 1).
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields, default)]
 pub struct InitConfig {
-    /// "random", "triangular" or "square".
-    pub placement: Placement,
+    /// "random"; "triangular" or "square" in 2D; "fcc" or "simple_cubic" in 3D. Absent: the
+    /// densest lattice ([`Config::placement`]).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub placement: Option<Placement>,
     /// "maxwell" or "fixed-speed".
     pub velocities: Velocities,
     /// Temperature kT (energy unit).
@@ -145,7 +190,7 @@ pub struct InitConfig {
 
 impl Default for InitConfig {
     fn default() -> Self {
-        InitConfig { placement: Placement::Triangular, velocities: Velocities::Maxwell, kt: 1.0 }
+        InitConfig { placement: None, velocities: Velocities::Maxwell, kt: 1.0 }
     }
 }
 
@@ -353,20 +398,16 @@ pub fn close_packing(d: usize) -> (f64, &'static str) {
 }
 
 impl Config {
-    /// Parses and validates TOML text for a 2D run; `source` names it in errors. A syntax
-    /// error or an unknown key is reported with its line and column.
+    /// Parses and validates TOML text (for the dimension it names, 2 by default); `source`
+    /// names it in errors. A syntax error or an unknown key is reported with its line and
+    /// column.
     pub fn parse(text: &str, source: &str) -> Result<Config, ConfigError> {
-        Config::parse_for(text, source, 2)
-    }
-
-    /// [`parse`](Self::parse) for a run in `dimension` dimensions.
-    pub fn parse_for(text: &str, source: &str, dimension: usize) -> Result<Config, ConfigError> {
         let config: Config = toml::from_str(text).map_err(|e| ConfigError::Syntax {
             source: source.to_string(),
             at: e.span().map(|span| line_column(text, span.start)),
             message: e.message().to_string(),
         })?;
-        config.check_for(dimension).map_err(|invalid| ConfigError::Invalid { source: source.to_string(), invalid })?;
+        config.check().map_err(|invalid| ConfigError::Invalid { source: source.to_string(), invalid })?;
         Ok(config)
     }
 
@@ -405,14 +446,32 @@ impl Config {
         self.species.iter().fold(0usize, |n, s| n.saturating_add(s.count))
     }
 
-    /// [`check_for`](Self::check_for) two dimensions, as [`parse`](Self::parse) does.
+    /// The placement: the one given, or the densest lattice of the dimension (triangular in
+    /// 2D, fcc in 3D).
+    pub fn placement(&self) -> Placement {
+        self.init.placement.unwrap_or(if self.dimension == 3 { Placement::Fcc } else { Placement::Triangular })
+    }
+
+    /// Validates every value for the dimension the configuration names, as
+    /// [`parse`](Self::parse) does.
     pub fn check(&self) -> Result<(), Invalid> {
-        self.check_for(2)
+        if !matches!(self.dimension, 2 | 3) {
+            return Err(Invalid::value("dimension", self.dimension.to_string(), "must be 2 (disks) or 3 (spheres)"));
+        }
+        self.check_for(self.dimension)
     }
 
     /// Validates every value for a run in `d` dimensions: a configuration built or edited in
-    /// memory, or carried by a checkpoint, is checked exactly like a file.
+    /// memory, or carried by a checkpoint, is checked exactly like a file. A configuration of
+    /// another dimension than `d` is refused.
     pub fn check_for(&self, d: usize) -> Result<(), Invalid> {
+        if self.dimension != d {
+            return Err(Invalid::value(
+                "dimension",
+                self.dimension.to_string(),
+                format!("this is a {d}D run: give dimension = {d}"),
+            ));
+        }
         let positive = |name: &str, x: f64| {
             if x.is_finite() && x > 0.0 {
                 Ok(())
@@ -456,16 +515,39 @@ impl Config {
                 }
             }
         }
-        if let Some(aspect) = self.sim_box.aspect {
-            positive("box.aspect", aspect)?;
+        if let Some(aspect) = &self.sim_box.aspect {
+            match aspect {
+                Aspect::Ratio(r) => positive("box.aspect", *r)?,
+                Aspect::Edges(e) => {
+                    if e.len() != d {
+                        return Err(Invalid::Entries {
+                            field: "box.aspect".into(),
+                            entries: e.len(),
+                            allowed: format!("give the proportions [{lengths}] or the single number Ly/Lx"),
+                        });
+                    }
+                    for (i, &x) in e.iter().enumerate() {
+                        positive(&format!("box.aspect[{i}]"), x)?;
+                    }
+                }
+            }
             if self.sim_box.size.is_some() {
                 return Err(Invalid::OnlyWith {
                     field: "box.aspect".into(),
-                    value: num(aspect),
+                    value: aspect.to_string(),
                     with: "packing_fraction".into(),
-                    allowed: format!("with size = [{lengths}] the aspect is Ly/Lx (remove one of them)"),
+                    allowed: format!("with size = [{lengths}] the size gives the shape (remove one of them)"),
                 });
             }
+        }
+        if let Some(placement) = self.init.placement
+            && !placement.exists_in(d)
+        {
+            return Err(Invalid::value(
+                "init.placement",
+                format!("\"{}\"", placement.name()),
+                format!("in {d}D use {}", Placement::allowed_in(d)),
+            ));
         }
         if self.species.is_empty() {
             return Err(Invalid::fields("species", "give at least one [[species]] with count, radius and mass"));
@@ -598,25 +680,50 @@ mod tests {
         }
     }
 
-    /// A configuration is checked for its dimension: the entries of the box and the limit
-    /// of close packing follow it (π/(2√3) for disks, π/√18 for spheres).
+    /// A configuration is checked for the dimension it names: the entries of the box, of
+    /// the boundaries and of the aspect, the placements and the limit of close packing follow
+    /// it (π/(2√3) for disks, π/√18 for spheres); a configuration of one dimension is refused
+    /// by a run of the other.
     #[test]
     fn the_dimension_decides_the_box() {
-        let spheres = DEFAULT_CONFIG.replace("packing_fraction = 0.5", "size = [20.0, 20.0, 20.0]");
-        let config = Config::parse_for(&spheres, "3d", 3).expect("three edges in 3D");
+        let three = |text: &str| format!("dimension = 3\n{text}");
+        let spheres = three(&DEFAULT_CONFIG.replace("packing_fraction = 0.5", "size = [20.0, 20.0, 20.0]"))
+            .replace("\"triangular\"", "\"fcc\"");
+        let config = Config::parse(&spheres, "3d").expect("three edges in 3D");
         assert_eq!(config.boundaries::<3>(), [Boundary::Periodic; 3]);
-        let err = Config::parse(&spheres, "2d").unwrap_err();
-        assert!(matches!(&err, ConfigError::Invalid { invalid: Invalid::Entries { entries: 3, .. }, .. }), "{err}");
+        assert_eq!(config.placement(), Placement::Fcc);
+        let err = Config::parse(&spheres.replace("dimension = 3\n", ""), "2d").unwrap_err();
         assert!(err.to_string().contains("box.size has 3 entries: give [Lx, Ly]"), "{err}");
-        let two = Config::parse_for(DEFAULT_CONFIG, "2d in 3d", 3);
-        assert!(two.is_ok(), "a packing fraction makes a box in any dimension");
+        let err = Config::parse(&three(DEFAULT_CONFIG).replace("packing_fraction = 0.5", "size = [20.0, 20.0]"), "s")
+            .unwrap_err();
+        assert!(matches!(&err, ConfigError::Invalid { invalid: Invalid::Entries { entries: 2, .. }, .. }), "{err}");
+        assert!(err.to_string().contains("box.size has 2 entries: give [Lx, Ly, Lz]"), "{err}");
+        let err = Config::parse(&three(DEFAULT_CONFIG), "lattice").unwrap_err().to_string();
+        assert!(
+            err.contains(r#"init.placement = "triangular": in 3D use placement = "fcc", "simple_cubic" or "random""#),
+            "{err}"
+        );
+        let err = Config::parse(&DEFAULT_CONFIG.replace("\"triangular\"", "\"fcc\""), "fcc").unwrap_err().to_string();
+        assert!(err.contains(r#"init.placement = "fcc": in 2D use placement = "triangular""#), "{err}");
+        let without = three(&DEFAULT_CONFIG.replace("placement = \"triangular\"\n", ""));
+        assert_eq!(Config::parse(&without, "default").unwrap().placement(), Placement::Fcc);
         let dense = DEFAULT_CONFIG.replace("packing_fraction = 0.5", "packing_fraction = 0.8");
         assert!(Config::parse(&dense, "disks").is_ok());
-        let err = Config::parse_for(&dense, "spheres", 3).unwrap_err().to_string();
+        let err =
+            Config::parse(&three(&dense.replace("\"triangular\"", "\"fcc\"")), "spheres").unwrap_err().to_string();
         assert!(err.contains("(0, 0.7405)") && err.contains("π/√18"), "{err}");
         let lists = DEFAULT_CONFIG.replace("boundary = \"periodic\"", "boundary = [\"periodic\", \"wall\"]");
         assert!(Config::parse(&lists, "2d").is_ok());
-        let err = Config::parse_for(&lists, "3d", 3).unwrap_err().to_string();
+        let err = Config::parse(&three(&lists.replace("\"triangular\"", "\"fcc\"")), "3d").unwrap_err().to_string();
         assert!(err.contains("box.boundary has 2 entries: give one per axis (3)"), "{err}");
+        let err = Config::parse(&DEFAULT_CONFIG.replace("seed = 1", "dimension = 4\nseed = 1"), "4d").unwrap_err();
+        assert!(err.to_string().contains("dimension = 4: must be 2 (disks) or 3 (spheres)"), "{err}");
+        let aspect =
+            three(&DEFAULT_CONFIG.replace("packing_fraction = 0.5", "packing_fraction = 0.3\naspect = [1.0, 2.0]"));
+        let err = Config::parse(&aspect.replace("\"triangular\"", "\"random\""), "a").unwrap_err().to_string();
+        assert!(err.contains("box.aspect has 2 entries: give the proportions [Lx, Ly, Lz]"), "{err}");
+        let two = Config::default_config();
+        let err = two.check_for(3).unwrap_err().to_string();
+        assert_eq!(err, "dimension = 2: this is a 3D run: give dimension = 3");
     }
 }

@@ -57,8 +57,11 @@ pub enum RunError {
     LatticeOverlap {
         /// The overlap found.
         error: SetupError,
-        /// The packing fraction up to which a triangular lattice holds these species.
+        /// The packing fraction up to which the densest lattice of the dimension holds
+        /// these species ([`lattice_limit`]).
         fits_up_to: f64,
+        /// That lattice: "triangular" (2D) or "fcc" (3D).
+        lattice: &'static str,
     },
     /// The initial state is not a valid configuration (overlap, box too small, …).
     Setup(SetupError),
@@ -76,9 +79,9 @@ impl fmt::Display for RunError {
             RunError::Box { error, from } => write!(f, "{error} ({from})"),
             RunError::Limit(e) => write!(f, "{e}"),
             RunError::Init(e) => write!(f, "initial state: {e}"),
-            RunError::LatticeOverlap { error, fits_up_to } => write!(
+            RunError::LatticeOverlap { error, fits_up_to, lattice } => write!(
                 f,
-                "initial state: {error}: the lattice's sites are closer than the largest contact distance; a triangular lattice holds these species up to η ≈ {fits_up_to:.4}"
+                "initial state: {error}: the lattice's sites are closer than the largest contact distance; a perfect {lattice} lattice holds these species up to η ≈ {fits_up_to:.4}"
             ),
             RunError::Setup(e) => write!(f, "initial state: {e}"),
             RunError::Particles(e) => write!(f, "the particles given: {e}"),
@@ -205,7 +208,8 @@ pub fn box_of<const D: usize>(config: &Config) -> SimBox<D> {
     match (&config.sim_box.size, config.sim_box.packing_fraction) {
         (Some(size), _) => SimBox { lengths: SVector::from_fn(|a, _| size[a]), boundary },
         (None, Some(eta)) => {
-            box_for_packing_fraction(&config.species, eta, boundary, config.init.placement, config.sim_box.aspect)
+            let edges = config.sim_box.aspect.as_ref().map(|a| a.edges::<D>());
+            box_for_packing_fraction(&config.species, eta, boundary, config.placement(), edges)
         }
         (None, None) => unreachable!("validated: size or packing fraction"),
     }
@@ -219,7 +223,7 @@ fn admit<const D: usize>(config: &Config, limits: &Limits) -> Result<(SimBox<D>,
     let reach = 2.0 * config.species.iter().map(|s| s.radius).fold(0.0, f64::max);
     check_box(&sim_box, reach).map_err(|error| {
         let b = &config.sim_box;
-        let from = match (b.packing_fraction, b.aspect) {
+        let from = match (b.packing_fraction, &b.aspect) {
             (Some(eta), Some(aspect)) => {
                 format!("the box comes from box.packing_fraction = {eta} and box.aspect = {aspect}")
             }
@@ -283,14 +287,18 @@ impl<const D: usize> Run<D> {
         let (sim_box, estimate) = admit::<D>(&config, &limits)?;
         let init = &config.init;
         let particles =
-            initial_particles(&config.species, &sim_box, init.placement, init.velocities, init.kt, config.seed)
+            initial_particles(&config.species, &sim_box, config.placement(), init.velocities, init.kt, config.seed)
                 .map_err(RunError::Init)?;
         let sim = Simulation::new(particles, sim_box).map_err(|error| match error {
             // On a lattice of a mixture, neighbours closer than the largest contact distance
             // can overlap: say so, and what would fit.
-            SetupError::Overlap { .. } if config.init.placement != Placement::Random => {
+            SetupError::Overlap { .. } if config.placement() != Placement::Random => {
                 match lattice_limit::<D>(&config.species) {
-                    Some(fits_up_to) => RunError::LatticeOverlap { error, fits_up_to },
+                    Some(fits_up_to) => RunError::LatticeOverlap {
+                        error,
+                        fits_up_to,
+                        lattice: if D == 3 { "fcc" } else { "triangular" },
+                    },
                     None => RunError::Setup(error),
                 }
             }

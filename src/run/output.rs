@@ -89,6 +89,30 @@ pub fn load_checkpoint<const D: usize>(path: &Path) -> Result<Checkpoint<D>, sup
     Checkpoint::load(path)
 }
 
+/// A checkpoint file read, of the dimension its run has.
+pub enum AnyCheckpoint {
+    /// Of disks.
+    Disks(Checkpoint<2>),
+    /// Of spheres.
+    Spheres(Checkpoint<3>),
+}
+
+/// Reads a checkpoint file of either dimension (verified: see [`Checkpoint::load`]).
+pub fn load_any_checkpoint(path: &Path) -> Result<AnyCheckpoint, super::CheckpointError> {
+    use super::CheckpointError;
+    let bytes = std::fs::read(path).map_err(|e| CheckpointError::Read(e.to_string()))?;
+    match super::checkpoint::dimension_of(&bytes) {
+        2 => Ok(AnyCheckpoint::Disks(Checkpoint::from_json(&bytes)?)),
+        3 => Checkpoint::from_json(&bytes).map(AnyCheckpoint::Spheres).map_err(|e| match e {
+            CheckpointError::Format(e) => CheckpointError::Format(format!(
+                "{e} (run.config.dimension = 3: every position and velocity has 3 entries)"
+            )),
+            e => e,
+        }),
+        d => Err(CheckpointError::Format(format!("run.config.dimension = {d}: collide runs in 2 or 3 dimensions"))),
+    }
+}
+
 /// The [`Sink`] of `collide run`: the trajectory and the checkpoints, while the run goes.
 pub struct Writer<'a, P: FnMut(Phase, f64)> {
     dir: &'a RunDir,

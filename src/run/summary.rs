@@ -64,6 +64,7 @@ impl<const D: usize> Run<D> {
             stall: self.ended.1.clone(),
             phase: self.phase,
             warnings,
+            dimension: D,
             n_particles: n,
             packing_fraction: particle_volume::<D>(&self.config.species) / sim_box.volume(),
             seed: self.config.seed,
@@ -130,6 +131,8 @@ pub struct Summary {
     /// What the numbers below should be read with.
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub warnings: Vec<String>,
+    /// 2 (disks) or 3 (spheres).
+    pub dimension: usize,
     /// N.
     pub n_particles: usize,
     /// η = Σπ Rᵢ² / A.

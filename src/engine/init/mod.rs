@@ -41,7 +41,7 @@ pub struct Species {
 
 /// Where the particles start.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
-#[serde(rename_all = "lowercase")]
+#[serde(rename_all = "snake_case")]
 pub enum Placement {
     /// Random sequential placement with rejection (dilute states; any dimension).
     Random,
@@ -49,6 +49,10 @@ pub enum Placement {
     Triangular,
     /// Square lattice (2D).
     Square,
+    /// Face-centred cubic lattice, four sites per cubic cell (vacancies at random; 3D).
+    Fcc,
+    /// Simple cubic lattice (3D).
+    SimpleCubic,
 }
 
 impl Placement {
@@ -58,6 +62,26 @@ impl Placement {
             Placement::Random => "random",
             Placement::Triangular => "triangular",
             Placement::Square => "square",
+            Placement::Fcc => "fcc",
+            Placement::SimpleCubic => "simple_cubic",
+        }
+    }
+
+    /// Whether it can place particles in `d` dimensions.
+    pub fn exists_in(self, d: usize) -> bool {
+        match self {
+            Placement::Random => true,
+            Placement::Triangular | Placement::Square => d == 2,
+            Placement::Fcc | Placement::SimpleCubic => d == 3,
+        }
+    }
+
+    /// The placements of `d` dimensions, as a configuration names them.
+    pub fn allowed_in(d: usize) -> &'static str {
+        match d {
+            2 => r#"placement = "triangular", "square" or "random""#,
+            3 => r#"placement = "fcc", "simple_cubic" or "random""#,
+            _ => r#"placement = "random""#,
         }
     }
 }
@@ -103,12 +127,11 @@ pub enum InitError {
     },
     /// Even the best lattice shape puts its sites closer than the smallest diameter.
     LatticeDoesNotFit {
-        /// "triangular" or "square".
+        /// "triangular", "square", "fcc" or "simple cubic".
         lattice: &'static str,
-        /// Columns of the best shape.
-        columns: usize,
-        /// Rows of the best shape.
-        rows: usize,
+        /// The best shape: grid points along each axis (columns, rows, layers; for fcc the
+        /// points of the cubic grid of half a cell, every other one a site).
+        shape: Vec<usize>,
         /// The distance between its nearest sites.
         spacing: f64,
         /// The largest diameter.
@@ -163,13 +186,16 @@ impl fmt::Display for InitError {
             }
             InitError::NotInDimension { placement, dimension } => write!(
                 f,
-                "placement = \"{}\" is a 2D lattice; in {dimension}D use placement = \"random\"",
-                placement.name()
+                "placement = \"{}\" is not a lattice of {dimension}D; use {}",
+                placement.name(),
+                Placement::allowed_in(*dimension)
             ),
-            InitError::LatticeDoesNotFit { lattice, columns, rows, spacing, diameter, fits_up_to } => {
+            InitError::LatticeDoesNotFit { lattice, shape, spacing, diameter, fits_up_to } => {
+                let shape = shape.iter().map(|n| n.to_string()).collect::<Vec<_>>().join(" × ");
+                let what = if *lattice == "fcc" { "grid points" } else { "sites" };
                 write!(
                     f,
-                    "a {lattice} lattice does not fit: its best shape in this box, {columns} × {rows} sites, puts them {spacing:.6} apart, less than the diameter {diameter}"
+                    "a {lattice} lattice does not fit: its best shape in this box, {shape} {what}, puts them {spacing:.6} apart, less than the diameter {diameter}"
                 )?;
                 match fits_up_to {
                     Some(eta) => write!(
@@ -215,43 +241,49 @@ pub fn particle_volume<const D: usize>(species: &[Species]) -> f64 {
         .sum()
 }
 
-/// The packing fraction up to which a perfect triangular lattice of N sites holds these
-/// species with nearest sites one largest diameter apart: `Σπ Rᵢ² / (N·(√3/2)·σ_max²)` (2D;
-/// `None` in other dimensions, which have no lattice placement yet).
+/// The packing fraction up to which a perfect densest lattice of N sites holds these
+/// species with nearest sites one largest diameter apart: `Σ V(Rᵢ) / (N·v_site)`, with the
+/// volume per site `v_site = (√3/2)·σ_max²` of the triangular lattice in 2D and `σ_max³/√2`
+/// of fcc in 3D.
 pub fn lattice_limit<const D: usize>(species: &[Species]) -> Option<f64> {
-    if D != 2 {
-        return None;
-    }
     let n: f64 = species.iter().map(|s| s.count as f64).sum();
     let sigma = 2.0 * species.iter().map(|s| s.radius).fold(0.0, f64::max);
-    Some(particle_volume::<2>(species) / (n * 0.5 * 3f64.sqrt() * sigma * sigma))
+    match D {
+        2 => Some(particle_volume::<2>(species) / (n * 0.5 * 3f64.sqrt() * sigma * sigma)),
+        3 => Some(particle_volume::<3>(species) / (n * sigma * sigma * sigma / 2f64.sqrt())),
+        _ => None,
+    }
 }
 
-/// The box with packing fraction `eta` for these species, `aspect = Ly/Lx` (the other edges
-/// equal to `Lx`). Without an aspect, a triangular lattice in a periodic box takes its own
-/// (so that it is perfect and wraps without defects), and every other start a cubic box.
+/// The box with packing fraction `eta` for these species, its edges in the proportions
+/// `edges` (`[1, Ly/Lx, …]`, any scale). Without them, a triangular lattice in a periodic box
+/// takes its own aspect (so that it is perfect and wraps without defects), and every other
+/// start a square or cubic box (in which N = 4k³ spheres make a perfect fcc crystal).
 pub fn box_for_packing_fraction<const D: usize>(
     species: &[Species],
     eta: f64,
     boundary: [Boundary; D],
     placement: Placement,
-    aspect: Option<f64>,
+    edges: Option<[f64; D]>,
 ) -> SimBox<D> {
     let n: usize = species.iter().map(|s| s.count).sum();
     let volume = particle_volume::<D>(species) / eta;
-    let aspect = match aspect {
-        Some(aspect) => aspect,
+    let edges = match edges {
+        Some(edges) => edges,
         None if D == 2 && placement == Placement::Triangular && boundary.iter().all(|&b| b == Boundary::Periodic) => {
             let (nx, ny) = lattice::triangular_shape(n, true);
-            ny as f64 * 3f64.sqrt() / 2.0 / nx as f64
+            std::array::from_fn(|a| if a == 1 { ny as f64 * 3f64.sqrt() / 2.0 / nx as f64 } else { 1.0 })
         }
-        None => 1.0,
+        None => [1.0; D],
     };
-    let lx = match D {
-        2 => (volume / aspect).sqrt(),
-        _ => (volume / aspect).powf(1.0 / D as f64),
+    // In 2D with edges [1, a] this is √(V/a) and a·√(V/a), as every earlier release computed
+    // it (boxes from a packing fraction are the same to the bit).
+    let product: f64 = edges.iter().product();
+    let unit = match D {
+        2 => (volume / product).sqrt(),
+        _ => (volume / product).cbrt(),
     };
-    SimBox { lengths: SVector::from_fn(|a, _| if a == 1 { lx * aspect } else { lx }), boundary }
+    SimBox { lengths: SVector::from_fn(|a, _| unit * edges[a]), boundary }
 }
 
 /// Builds the initial particles.
@@ -276,10 +308,26 @@ pub fn initial_particles<const D: usize>(
             return Err(InitError::BoxTooSmall { axis, length, diameter: 2.0 * rmax });
         }
     }
+    if !placement.exists_in(D) {
+        return Err(InitError::NotInDimension { placement, dimension: D });
+    }
     let positions: Vec<SVector<f64, D>> = match placement {
         Placement::Random => random::positions(&kinds, species, sim_box, &mut rng)?,
-        Placement::Triangular | Placement::Square if D != 2 => {
-            return Err(InitError::NotInDimension { placement, dimension: D });
+        Placement::Fcc | Placement::SimpleCubic => {
+            let kind = if placement == Placement::Fcc { lattice::Kind::Fcc } else { lattice::Kind::SimpleCubic };
+            let eta = particle_volume::<D>(species) / sim_box.volume();
+            let space = SimBox {
+                lengths: SVector::<f64, 3>::from_fn(|a, _| sim_box.lengths[a]),
+                boundary: std::array::from_fn(|a| sim_box.boundary[a]),
+            };
+            let mut sites = lattice::sites_3d(kind, n, &space, rmax, rmin, eta)?;
+            if sites.len() > n {
+                sites.shuffle(&mut rng);
+                sites.truncate(n);
+                // Keep a spatial order (layer by layer, row by row) for cache locality.
+                sites.sort_by(|a, b| a[2].total_cmp(&b[2]).then(a[1].total_cmp(&b[1])).then(a[0].total_cmp(&b[0])));
+            }
+            sites.into_iter().map(|s| SVector::from_fn(|a, _| s[a])).collect()
         }
         Placement::Triangular | Placement::Square => {
             let kind =
