@@ -48,6 +48,8 @@ enum Command {
     /// One benchmark point in a process of its own (used by `collide bench`).
     #[command(hide = true)]
     BenchPoint {
+        #[arg(long, default_value_t = 2, value_parser = clap::value_parser!(u8).range(2..=3))]
+        dimension: u8,
         #[arg(long)]
         n: usize,
         #[arg(long)]
@@ -101,7 +103,7 @@ struct ExperimentArgs {
 
 #[derive(Args)]
 struct ValidateArgs {
-    /// CI-sized experiments (seconds) instead of report quality (about three minutes).
+    /// CI-sized experiments (seconds) instead of report quality (about eight minutes).
     #[arg(long)]
     quick: bool,
     /// Seed of the initial states.
@@ -223,8 +225,8 @@ fn run(cli: Cli) -> Result<ExitCode> {
         Command::Validate(args) => validate(args),
         Command::Check => check(),
         Command::Bench(args) => bench(args),
-        Command::BenchPoint { n, eta, warmup, timed, seed, neighbourhood } => {
-            let point = collide::bench::measure(n, eta, neighbourhood, warmup, timed, seed)?;
+        Command::BenchPoint { dimension, n, eta, warmup, timed, seed, neighbourhood } => {
+            let point = collide::bench::measure(dimension as usize, n, eta, neighbourhood, warmup, timed, seed)?;
             say!("{}", serde_json::to_string(&point)?);
             Ok(ExitCode::SUCCESS)
         }
@@ -497,12 +499,12 @@ fn run_simulation(args: RunArgs) -> Result<ExitCode> {
 
 fn validate(args: ValidateArgs) -> Result<ExitCode> {
     use collide::lab::{Options, check::table, report::validate};
-    let options = Options { quick: args.quick, seed: args.seed, out: args.out };
+    let options = Options { quick: args.quick, seed: args.seed, out: args.out, dimension: 2 };
     let results = validate(&options, |name| eprintln!("running {name} …"))?;
     for r in &results {
-        say!("{}", table(&r.name, &r.checks).trim_end());
+        say!("{}", table(&r.slug(), &r.checks).trim_end());
     }
-    let failed: Vec<&str> = results.iter().filter(|r| !r.passed()).map(|r| r.name.as_str()).collect();
+    let failed: Vec<String> = results.iter().filter(|r| !r.passed()).map(|r| r.slug()).collect();
     say!("report: {}", options.out.join("index.html").display());
     if failed.is_empty() {
         say!("all checks pass");
@@ -519,16 +521,16 @@ fn bench(args: BenchArgs) -> Result<ExitCode> {
     let (points, warmup, timed) = matrix(args.quick);
     let exe = std::env::current_exe().context("locating the collide binary")?;
     let mut results = Vec::new();
-    for (n, eta) in points {
-        eprintln!("N = {n}, η = {eta} …");
+    for (d, n, eta) in points {
+        eprintln!("{d}D, N = {n}, η = {eta} …");
         let output = std::process::Command::new(&exe)
-            .args(["bench-point", "--n", &n.to_string(), "--eta", &eta.to_string()])
+            .args(["bench-point", "--dimension", &d.to_string(), "--n", &n.to_string(), "--eta", &eta.to_string()])
             .args(["--warmup", &warmup.to_string(), "--timed", &timed(n).to_string()])
             .args(["--neighbourhood", args.neighbourhood.name()])
             .output()
             .context("running a benchmark point")?;
         if !output.status.success() {
-            bail!("benchmark point N = {n}, η = {eta} failed: {}", String::from_utf8_lossy(&output.stderr));
+            bail!("benchmark point {d}D, N = {n}, η = {eta} failed: {}", String::from_utf8_lossy(&output.stderr));
         }
         let point: BenchPoint = serde_json::from_slice(&output.stdout).context("reading a benchmark point")?;
         results.push(point);

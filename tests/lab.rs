@@ -17,7 +17,7 @@ fn out(name: &str) -> std::path::PathBuf {
 fn assert_svgs(result: &ExperimentResult, dir: &Path) {
     assert!(!result.plots.is_empty());
     for plot in &result.plots {
-        let svg = std::fs::read_to_string(dir.join(&result.name).join(plot)).unwrap();
+        let svg = std::fs::read_to_string(dir.join(result.slug()).join(plot)).unwrap();
         assert!(svg.starts_with("<svg"), "{plot} is not SVG");
         // Axis labels with units (or an explicit 'dimensionless'), a legend, and data marks.
         assert!(svg.matches("<text").count() >= 10, "{plot}: too little text");
@@ -30,7 +30,7 @@ fn assert_svgs(result: &ExperimentResult, dir: &Path) {
 #[test]
 fn maxwell_boltzmann_quick_passes_and_writes_its_outputs() {
     let dir = out("lab-mb");
-    let options = Options { quick: true, seed: 1, out: dir.clone() };
+    let options = Options { quick: true, seed: 1, out: dir.clone(), dimension: 2 };
     let result = maxwell_boltzmann::run(&options).unwrap();
     result.write(&dir).unwrap();
     assert!(result.passed(), "{}", collide::lab::check::table("maxwell_boltzmann", &result.checks));
@@ -99,7 +99,7 @@ fn maxwell_boltzmann_checks_can_fail() {
 fn equation_of_state_quick_passes_and_writes_points() {
     use collide::lab::equation_of_state;
     let dir = out("lab-eos");
-    let result = equation_of_state::run(&Options { quick: true, seed: 1, out: dir.clone() }).unwrap();
+    let result = equation_of_state::run(&Options { quick: true, seed: 1, out: dir.clone(), dimension: 2 }).unwrap();
     result.write(&dir).unwrap();
     assert!(result.passed(), "{}", collide::lab::check::table("equation_of_state", &result.checks));
     assert!(result.checks.len() >= 3);
@@ -116,10 +116,12 @@ fn equation_of_state_quick_passes_and_writes_points() {
 }
 
 /// The reference equations of state at known points, and checks failing for a pressure
-/// that is off (a factor 1.05, or an ideal gas where the fluid is dense).
+/// that is off: by a few standard errors at report-size precision, a factor 1.05, or an ideal
+/// gas where the fluid is dense — in both dimensions and both phases of spheres.
 #[test]
 fn equation_of_state_references_and_checks_can_fail() {
-    use collide::lab::equation_of_state::{Point, check_point, z_henderson, z_slhy, z_virial};
+    use collide::lab::equation_of_state::{Phase, Point, check_point, z_henderson, z_liu_disks, z_slhy, z_virial};
+    use collide::theory::{z_hansen_goos, z_speedy_fcc};
     assert_eq!(z_henderson(0.5), 4.125);
     // SLHY at η = 0.5: 1/(2η_cp−1)η²/η_cp²) with 1 − 2η = 0.
     assert!(
@@ -127,21 +129,80 @@ fn equation_of_state_references_and_checks_can_fail() {
             < 1e-12
     );
     assert!((z_virial(0.1) - 1.236_144).abs() < 1e-6, "{}", z_virial(0.1));
-    let point = |eta: f64, z: f64| Point {
+    let point = |dimension: usize, phase: Phase, eta: f64, z: f64, z_err: f64| Point {
+        dimension,
         eta,
         z,
-        z_err: 0.004,
-        n_particles: 1024,
-        collisions: 1_000_000,
+        z_err,
+        phase,
+        n_particles: 2048,
+        collisions: 2_000_000,
         equilibration_per_particle: 500.0,
     };
-    for eta in [0.1, 0.3, 0.45] {
-        let truth = if eta <= 0.2 { z_virial(eta) } else { z_henderson(eta) };
-        assert!(check_point(&point(eta, truth)).unwrap().pass);
-        assert!(!check_point(&point(eta, 1.05 * truth)).unwrap().pass, "η = {eta}: 5 % off must fail");
-        assert!(!check_point(&point(eta, 1.0)).unwrap().pass, "η = {eta}: an ideal gas must fail");
+    let cases = [
+        (2, Phase::Fluid, 0.1, z_virial(0.1)),
+        (2, Phase::Fluid, 0.3, z_liu_disks(0.3)),
+        (2, Phase::Fluid, 0.5, z_liu_disks(0.5)),
+        (3, Phase::Fluid, 0.3, z_hansen_goos(0.3)),
+        (3, Phase::Fluid, 0.49, z_hansen_goos(0.49)),
+        (3, Phase::Fcc, 0.6, z_speedy_fcc(0.6)),
+        (3, Phase::Fcc, 0.7, z_speedy_fcc(0.7)),
+    ];
+    for (d, phase, eta, truth) in cases {
+        // A relative standard error of 10⁻³, as the report-size runs measure.
+        let err = 1e-3 * truth;
+        assert!(check_point(&point(d, phase, eta, truth, err)).unwrap().pass);
+        assert!(check_point(&point(d, phase, eta, truth + 2.0 * err, err)).unwrap().pass);
+        let wrong = |z: f64| !check_point(&point(d, phase, eta, z, err)).unwrap().pass;
+        assert!(wrong(truth + 6.0 * err) && wrong(truth - 6.0 * err), "{d}D η = {eta}: 6σ off must fail");
+        assert!(wrong(1.05 * truth), "{d}D η = {eta}: 5 % off must fail");
+        assert!(wrong(1.0), "{d}D η = {eta}: an ideal gas must fail");
     }
-    assert!(check_point(&point(0.65, 8.0)).is_none(), "no check above η = 0.5");
+    // The tightened 2D check: at η = 0.5 with the report's error (0.0035), Henderson's value —
+    // once the reference, 0.48 % (5.7σ) above Liu's — fails, as does Liu's ± 6σ; the old
+    // allowance (0.5 % of Henderson's Z, tolerance 0.036) passed anything within ten.
+    let liu = z_liu_disks(0.5);
+    let at = |z: f64| check_point(&point(2, Phase::Fluid, 0.5, z, 0.0035)).unwrap();
+    assert!(at(liu).pass);
+    assert!(!at(z_henderson(0.5)).pass, "{:?}", at(z_henderson(0.5)));
+    assert!(!at(liu + 6.0 * 0.0035).pass && !at(liu - 6.0 * 0.0035).pass);
+    assert!(at(liu + 3.0 * 0.0035).pass && at(liu - 3.0 * 0.0035).pass);
+    // No reference states its accuracy for dense disks, the metastable fluid of spheres or a
+    // crystal below melting.
+    assert!(check_point(&point(2, Phase::Fluid, 0.7, 9.0, 0.01)).is_none());
+    assert!(check_point(&point(3, Phase::Fluid, 0.52, 15.0, 0.01)).is_none());
+    assert!(check_point(&point(3, Phase::Fcc, 0.5, 9.6, 0.01)).is_none());
+}
+
+/// Every experiment in 3D (quick): its checks pass and it writes `<name>_3d/result.json` with
+/// the layout of 2D, and its plots.
+#[test]
+fn every_experiment_runs_in_three_dimensions() {
+    for (name, experiment) in collide::lab::EXPERIMENTS {
+        let dir = out(&format!("lab3-{name}"));
+        let result = experiment(&Options { quick: true, seed: 1, out: dir.clone(), dimension: 3 }).unwrap();
+        result.write(&dir).unwrap();
+        assert!(result.passed(), "{}", collide::lab::check::table(&result.slug(), &result.checks));
+        let json: serde_json::Value =
+            serde_json::from_str(&std::fs::read_to_string(dir.join(format!("{name}_3d/result.json"))).unwrap())
+                .unwrap();
+        assert_eq!(json["dimension"], 3);
+        assert_eq!(json["name"], *name);
+        for key in ["parameters", "data", "checks", "plots"] {
+            assert!(json.get(key).is_some(), "{name}: result.json lacks {key}");
+        }
+        if *name == "equation_of_state" {
+            let points = json["data"]["points"].as_array().unwrap();
+            let phases: Vec<&str> = points.iter().map(|p| p["phase"].as_str().unwrap()).collect();
+            assert_eq!(phases, ["fluid", "fluid", "fcc"]);
+            for p in points {
+                for key in ["eta", "Z", "Z_err", "phase", "n_particles", "collisions"] {
+                    assert!(p.get(key).is_some(), "a point lacks {key}");
+                }
+            }
+        }
+        assert_svgs(&result, &dir);
+    }
 }
 
 /// `collide validate --quick`: every experiment, one self-contained HTML page and a Markdown
@@ -157,10 +218,12 @@ fn validate_writes_the_report() {
     let html = std::fs::read_to_string(dir.join("index.html")).unwrap();
     let md = std::fs::read_to_string(dir.join("report.md")).unwrap();
     for (name, _) in collide::lab::EXPERIMENTS {
-        assert!(html.contains(&format!("id=\"{name}\"")) && md.contains(&format!("## {name}")), "{name} missing");
-        assert!(dir.join(name).join("result.json").exists());
+        for slug in [name.to_string(), format!("{name}_3d")] {
+            assert!(html.contains(&format!("id=\"{slug}\"")) && md.contains(&format!("## {slug}\n")), "{slug} missing");
+            assert!(dir.join(&slug).join("result.json").exists());
+        }
     }
-    assert!(html.matches("<svg").count() >= 6, "plots are inlined");
+    assert!(html.matches("<svg").count() >= 12, "plots are inlined");
     assert!(md.contains("seed 3") && md.contains(env!("CARGO_PKG_VERSION")) && md.contains("cores"));
     assert!(md.contains("ALL CHECKS PASS") && !md.contains("| FAIL |"));
 }
@@ -169,7 +232,7 @@ fn validate_writes_the_report() {
 fn wall_pressure_quick_passes() {
     use collide::lab::wall_pressure;
     let dir = out("lab-wall");
-    let result = wall_pressure::run(&Options { quick: true, seed: 1, out: dir.clone() }).unwrap();
+    let result = wall_pressure::run(&Options { quick: true, seed: 1, out: dir.clone(), dimension: 2 }).unwrap();
     result.write(&dir).unwrap();
     assert!(result.passed(), "{}", collide::lab::check::table("wall_pressure", &result.checks));
     assert!(result.checks.len() >= 4);
@@ -178,19 +241,28 @@ fn wall_pressure_quick_passes() {
 
 #[test]
 fn wall_pressure_checks_can_fail() {
-    use collide::lab::wall_pressure::{WalledState, eos_check, ideal_gas_check, identity_check, one_disk};
+    use collide::lab::wall_pressure::{
+        WalledState, eos_check, ideal_gas_check, identity_check, one_disk, one_particle,
+    };
     // The one-disk ideal gas: right as measured; wrong by 1 %, or divided by the full box
     // area instead of the accessible one, it fails.
     let (p, expected, tolerance) = one_disk(2.0e4).unwrap();
     assert!(ideal_gas_check(p, expected, tolerance).pass);
     assert!(!ideal_gas_check(1.01 * p, expected, tolerance).pass);
     assert!(!ideal_gas_check(p * (8.0 * 6.0) / (9.0 * 7.0), expected, tolerance).pass);
+    // And one sphere: divided by the full box volume instead of the accessible one, it fails.
+    let (p, expected, tolerance) = one_particle::<3>(2.0e4).unwrap();
+    assert!(ideal_gas_check(p, expected, tolerance).pass);
+    assert!(!ideal_gas_check(p * (8.0 * 6.0 * 7.0) / (9.0 * 7.0 * 8.0), expected, tolerance).pass);
     let good = WalledState {
+        dimension: 2,
         eta: 0.4,
         n_particles: 1600,
         kt: 1.0,
         p_wall: 0.0,
         p_wall_err: 0.004,
+        p_middle: 0.0,
+        p_middle_tolerance: 0.014,
         p_virial: 0.0,
         p_virial_err: 0.004,
         difference: 0.001,
@@ -200,14 +272,26 @@ fn wall_pressure_checks_can_fail() {
         n_accessible: 0.52,
     };
     let truth = good.p_eos_mid().0;
-    let state = |p: f64, diff: f64| WalledState { p_wall: p, p_virial: p - diff, difference: diff, ..good.clone() };
+    let state = |p: f64, diff: f64| WalledState {
+        p_wall: p,
+        p_middle: p,
+        p_virial: p - diff,
+        difference: diff,
+        ..good.clone()
+    };
     assert!(eos_check(&state(truth, 0.001)).unwrap().pass);
     assert!(identity_check(&state(truth, 0.001)).pass);
-    // A pressure 5 % high, an ideal gas at this density, a broken identity (a wall pressure
-    // divided by the full wall length instead of the accessible one differs by σ/L ≈ 2.5 %).
+    // A pressure 5 % high (the whole walls' mean at η = 0.6 sits 3 % high), an ideal gas at
+    // this density, a broken identity (a wall pressure divided by the full wall length instead
+    // of the accessible one differs by σ/L ≈ 2.5 %).
     assert!(!eos_check(&state(1.05 * truth, 0.001)).unwrap().pass);
     assert!(!eos_check(&state(good.n_mid * good.kt, 0.001)).unwrap().pass);
     assert!(!identity_check(&state(truth, 0.025 * truth)).pass);
+    // Spheres: Hansen-Goos at the bulk density; 5 % off fails.
+    let spheres = WalledState { dimension: 3, n_mid: 0.6, n_mid_tolerance: 0.002, p_middle_tolerance: 0.03, ..good };
+    let truth = spheres.p_eos_mid().0;
+    let at = |p: f64| eos_check(&WalledState { p_middle: p, ..spheres.clone() }).unwrap();
+    assert!(at(truth).pass && !at(1.05 * truth).pass && !at(0.95 * truth).pass, "{truth}");
 }
 
 #[test]
@@ -218,7 +302,7 @@ fn collision_rate_and_equipartition_quick_pass() {
         (equipartition::NAME, equipartition::run),
     ] {
         let dir = out(&format!("lab-{name}"));
-        let result = experiment(&Options { quick: true, seed: 1, out: dir.clone() }).unwrap();
+        let result = experiment(&Options { quick: true, seed: 1, out: dir.clone(), dimension: 2 }).unwrap();
         result.write(&dir).unwrap();
         assert!(result.passed(), "{}", collide::lab::check::table(name, &result.checks));
         assert_svgs(&result, &dir);
@@ -227,25 +311,33 @@ fn collision_rate_and_equipartition_quick_pass() {
 
 #[test]
 fn collision_rate_checks_can_fail() {
-    use collide::lab::collision_rate::{RateState, checks_for, g_henderson, gamma_enskog};
-    let truth = gamma_enskog(0.4, g_henderson(0.4));
-    let state = |gamma: f64, diff: f64| RateState {
-        eta: 0.4,
-        n_particles: 1600,
-        gamma,
-        gamma_err: 0.01,
-        z: 2.83,
-        z_err: 0.003,
-        identity_difference: diff,
-        identity_difference_err: 0.01,
-        mean_free_path: 0.2,
-    };
-    assert!(checks_for(&state(truth, 0.0)).iter().all(|c| c.pass));
-    // A rate 5 % off (e.g. collisions counted once instead of for both partners would be 50 %),
-    // and an identity broken by 0.1 (a pressure 2 % off at this density).
-    assert!(!checks_for(&state(1.05 * truth, 0.0))[1].pass);
-    assert!(!checks_for(&state(0.5 * truth, 0.0))[1].pass);
-    assert!(!checks_for(&state(truth, 0.1))[0].pass);
+    use collide::lab::collision_rate::{RateState, checks_for, enskog_reference};
+    for (dimension, eta, n) in [(2, 0.4, 1600), (3, 0.4, 1728)] {
+        let (truth, _, _) = enskog_reference(dimension, eta);
+        // The report's relative error on Γ, about 1.3·10⁻³.
+        let err = 1.3e-3 * truth;
+        let state = |gamma: f64, diff: f64| RateState {
+            dimension,
+            eta,
+            n_particles: n,
+            gamma,
+            gamma_err: err,
+            z: 2.83,
+            z_err: 0.003,
+            identity_difference: diff,
+            identity_difference_err: 0.01,
+            mean_free_path: 0.2,
+        };
+        assert!(checks_for(&state(truth, 0.0)).iter().all(|c| c.pass));
+        // A rate 6 standard errors off (the tightened check), 5 % off, or half the truth
+        // (collisions counted once instead of for both partners); an identity broken by 0.1
+        // (a pressure 2 % off at this density).
+        assert!(!checks_for(&state(truth + 6.0 * err, 0.0))[1].pass, "{dimension}D");
+        assert!(!checks_for(&state(truth - 6.0 * err, 0.0))[1].pass, "{dimension}D");
+        assert!(!checks_for(&state(1.05 * truth, 0.0))[1].pass);
+        assert!(!checks_for(&state(0.5 * truth, 0.0))[1].pass);
+        assert!(!checks_for(&state(truth, 0.1))[0].pass);
+    }
 }
 
 /// A mixture whose species stay at different temperatures fails; one that equilibrates passes.
@@ -253,8 +345,10 @@ fn collision_rate_checks_can_fail() {
 fn equipartition_check_can_fail() {
     use collide::lab::equipartition::relax;
     // Too short to relax (5 mean free times from kT 2 vs 0.5): the difference is still large.
-    let (_, check) = relax([0.5, 0.5], 400, 5.0, 1, "short").unwrap();
+    let (_, check) = relax::<2>([0.5, 0.5], 400, 5.0, 1, "short").unwrap();
     assert!(!check.pass, "{check:?}");
-    let (_, check) = relax([0.5, 0.5], 400, 300.0, 1, "long").unwrap();
+    let (_, check) = relax::<3>([0.5, 0.5], 500, 5.0, 1, "short").unwrap();
+    assert!(!check.pass, "{check:?}");
+    let (_, check) = relax::<2>([0.5, 0.5], 400, 300.0, 1, "long").unwrap();
     assert!(check.pass, "{check:?}");
 }

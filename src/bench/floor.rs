@@ -100,7 +100,7 @@ impl Floor {
                 allowed: "the floor needs at least 16 disks (two full rows of neighbours)",
             });
         }
-        let (particles, sim_box) = initial_state(n, eta, seed)?;
+        let (particles, sim_box) = initial_state::<2>(n, eta, seed)?;
         // In 2 MB pages where large, as the engine's arrays (`engine::pages`).
         let disks: Vec<Disk> = pages::collect(particles.iter().map(|p| Disk {
             position: p.position.into(),

@@ -1,9 +1,10 @@
 //! The benchmarks: steady-state collisions per second across N and packing fraction, beside
 //! the hardware's floor ([`floor`]) measured in the same process.
 //!
-//! Each point builds a periodic box from a triangular lattice (Maxwell velocities, kT = 1),
-//! runs a warm-up that is not timed (so the lattice has melted and the queue has reached its
-//! working size), then times a fixed number of pair collisions on one core. Memory is
+//! Each point builds a periodic box of disks or spheres from a lattice ([`state`]; Maxwell
+//! velocities, kT = 1), runs a warm-up that is not timed (so the lattice has melted and the
+//! queue has reached its working size), then times a fixed number of pair collisions on one
+//! core. Memory is
 //! reported twice: the engine's own account of its heap (capacities of the particle array,
 //! the event queue, the neighbour lists and their grid) and the process's peak resident set size when each point
 //! runs in a process of its own (`collide bench` does that).
@@ -21,6 +22,9 @@ use std::time::Instant;
 /// One measured configuration.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct BenchPoint {
+    /// 2 (disks) or 3 (spheres).
+    #[serde(default = "two")]
+    pub dimension: usize,
     /// N.
     pub n_particles: usize,
     /// Packing fraction.
@@ -70,6 +74,10 @@ pub struct BenchPoint {
     pub fraction_of_floor: Option<f64>,
 }
 
+fn two() -> usize {
+    2
+}
+
 /// The process's peak resident set size (Linux `VmHWM`), if readable.
 pub fn peak_rss_bytes() -> Option<u64> {
     let status = std::fs::read_to_string("/proc/self/status").ok()?;
@@ -78,9 +86,10 @@ pub fn peak_rss_bytes() -> Option<u64> {
     Some(kb * 1024)
 }
 
-/// Measures one point: `warmup_per_particle` untimed collisions per particle, then
-/// `timed` collisions, with the neighbourhood asked for.
+/// Measures one point in `d` dimensions (2 or 3): `warmup_per_particle` untimed collisions
+/// per particle, then `timed` collisions, with the neighbourhood asked for.
 pub fn measure(
+    d: usize,
     n: usize,
     eta: f64,
     neighbourhood: Neighbourhood,
@@ -88,7 +97,22 @@ pub fn measure(
     timed: u64,
     seed: u64,
 ) -> Result<BenchPoint, BenchError> {
-    let (particles, sim_box) = initial_state(n, eta, seed)?;
+    match d {
+        2 => measure_in::<2>(n, eta, neighbourhood, warmup_per_particle, timed, seed),
+        3 => measure_in::<3>(n, eta, neighbourhood, warmup_per_particle, timed, seed),
+        _ => Err(BenchError::Option { flag: "dimension", value: d.to_string(), allowed: "2 (disks) or 3 (spheres)" }),
+    }
+}
+
+fn measure_in<const D: usize>(
+    n: usize,
+    eta: f64,
+    neighbourhood: Neighbourhood,
+    warmup_per_particle: u64,
+    timed: u64,
+    seed: u64,
+) -> Result<BenchPoint, BenchError> {
+    let (particles, sim_box) = initial_state::<D>(n, eta, seed)?;
     let mut sim = Simulation::with_neighbourhood(particles, sim_box, neighbourhood).map_err(BenchError::Setup)?;
     let warmup = warmup_per_particle * n as u64;
     while sim.counts().pair < warmup {
@@ -106,10 +130,12 @@ pub fn measure(
     // Read before the floor allocates; the engine's memory goes first.
     let (peak_rss_bytes, huge_page_bytes) = (peak_rss_bytes(), crate::engine::internals::huge_page_bytes());
     drop(sim);
-    // (The floor needs a full row of neighbours: none below 2·WIDTH disks.)
-    let floor = (n >= 2 * floor::WIDTH).then(|| floor::measure(n, eta, 2 * n as u64, timed, seed)).transpose()?;
+    // (The floor needs a full row of neighbours: none below 2·WIDTH disks; it is of disks.)
+    let floor =
+        (D == 2 && n >= 2 * floor::WIDTH).then(|| floor::measure(n, eta, 2 * n as u64, timed, seed)).transpose()?;
     let collisions_per_second = timed as f64 / seconds;
     Ok(BenchPoint {
+        dimension: D,
         n_particles: n,
         packing_fraction: eta,
         neighbourhood,
@@ -139,10 +165,17 @@ pub fn measure(
 /// on (the counts are in `benches/HISTORY.md`).
 pub const WARMUP: u64 = 20;
 
-/// The matrix: (N, η) pairs, warm-up collisions per particle, timed collisions for N.
-pub fn matrix(quick: bool) -> (Vec<(usize, f64)>, u64, fn(usize) -> u64) {
+/// The matrix: (dimension, N, η), warm-up collisions per particle, timed collisions for N.
+/// Disks at η = 0.3 and 0.65, spheres at η = 0.3 and 0.45 (a dense fluid below freezing),
+/// N = 10³ … 10⁶; the quick matrix is disks at N = 10³ and 10⁴ and spheres at N = 10⁴, η = 0.45.
+pub fn matrix(quick: bool) -> (Vec<(usize, usize, f64)>, u64, fn(usize) -> u64) {
     let sizes: &[usize] = if quick { &[1_000, 10_000] } else { &[1_000, 10_000, 100_000, 1_000_000] };
-    let points = sizes.iter().flat_map(|&n| [0.3, 0.65].map(|eta| (n, eta))).collect();
+    let mut points: Vec<(usize, usize, f64)> = sizes.iter().flat_map(|&n| [0.3, 0.65].map(|eta| (2, n, eta))).collect();
+    if quick {
+        points.push((3, 10_000, 0.45));
+    } else {
+        points.extend(sizes.iter().flat_map(|&n| [0.3, 0.45].map(|eta| (3, n, eta))));
+    }
     if quick {
         (points, WARMUP, |n| (2 * n as u64).max(200_000))
     } else {
@@ -169,8 +202,8 @@ pub fn today() -> String {
 pub fn markdown(points: &[BenchPoint], command: &str, machine: &str) -> String {
     let mut md = format!(
         "# collide benchmark report\n\n{} · collide {} · {machine} · one core\n\nCommand: `{command}`\n\n\
-         | N | η | neighbourhood | collisions/s | ns/collision | events/s | pair : wall : rebuild : stale per collision | engine bytes/particle | peak RSS bytes/particle | floor collisions/s | of the floor |\n\
-         |---|---|---|---|---|---|---|---|---|---|---|\n",
+         | d | N | η | neighbourhood | collisions/s | ns/collision | events/s | pair : wall : rebuild : stale per collision | engine bytes/particle | peak RSS bytes/particle | floor collisions/s | of the floor |\n\
+         |---|---|---|---|---|---|---|---|---|---|---|---|\n",
         today(),
         env!("CARGO_PKG_VERSION")
     );
@@ -178,7 +211,8 @@ pub fn markdown(points: &[BenchPoint], command: &str, machine: &str) -> String {
         let e = &p.events_by_kind;
         let per = |x: u64| x as f64 / e.pair.max(1) as f64;
         md.push_str(&format!(
-            "| {} | {} | {} | {:.3e} | {:.0} | {:.3e} | 1 : {:.2} : {:.2} : {:.2} | {:.0} | {} | {} | {} |\n",
+            "| {} | {} | {} | {} | {:.3e} | {:.0} | {:.3e} | 1 : {:.2} : {:.2} : {:.2} | {:.0} | {} | {} | {} |\n",
+            p.dimension,
             p.n_particles,
             p.packing_fraction,
             if p.lists { "lists" } else { "grid" },
@@ -202,32 +236,33 @@ pub fn markdown(points: &[BenchPoint], command: &str, machine: &str) -> String {
     md
 }
 
-/// The chart: collisions per second against N (log₁₀ N on the x axis), one series per η,
-/// and the floor's beside them.
+/// The chart: collisions per second against N (log₁₀ N on the x axis), one series per
+/// dimension and η, and the floor's beside them.
 pub fn chart(points: &[BenchPoint]) -> Chart {
-    let mut etas: Vec<f64> = points.iter().map(|p| p.packing_fraction).collect();
+    let mut series: Vec<(usize, f64)> = points.iter().map(|p| (p.dimension, p.packing_fraction)).collect();
     // Sorted first: the matrix runs N by N, so equal packing fractions are not adjacent (an
     // unsorted dedup drew every series once per N).
-    etas.sort_by(f64::total_cmp);
-    etas.dedup();
+    series.sort_by(|a, b| a.0.cmp(&b.0).then(a.1.total_cmp(&b.1)));
+    series.dedup();
     Chart {
         title: "Steady-state collisions per second (one core)".into(),
-        x_label: "log₁₀ N (number of disks)".into(),
+        x_label: "log₁₀ N (number of particles)".into(),
         y_label: "collisions per second (10⁶/s)".into(),
         legend_left: false,
-        series: etas
+        series: series
             .iter()
-            .flat_map(|&eta| {
+            .flat_map(|&(d, eta)| {
                 let at = |rate: fn(&BenchPoint) -> Option<f64>| -> Vec<(f64, f64)> {
                     points
                         .iter()
-                        .filter(|p| p.packing_fraction == eta)
+                        .filter(|p| p.dimension == d && p.packing_fraction == eta)
                         .filter_map(|p| Some(((p.n_particles as f64).log10(), rate(p)? / 1e6)))
                         .collect()
                 };
-                let engine = Series::points(&format!("η = {eta}"), at(|p| Some(p.collisions_per_second)));
+                let what = if d == 2 { "disks" } else { "spheres" };
+                let engine = Series::points(&format!("{what}, η = {eta}"), at(|p| Some(p.collisions_per_second)));
                 let floor = at(|p| p.floor_collisions_per_second);
-                let floor = (!floor.is_empty()).then(|| Series::line(&format!("floor, η = {eta}"), floor));
+                let floor = (!floor.is_empty()).then(|| Series::line(&format!("floor, {what}, η = {eta}"), floor));
                 std::iter::once(engine).chain(floor)
             })
             .collect(),

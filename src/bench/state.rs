@@ -1,5 +1,7 @@
-//! A benchmark's initial state, the engine's and the floor's alike: N disks of diameter 1 on
-//! a triangular lattice at packing fraction η in a periodic box, Maxwell velocities at kT = 1.
+//! A benchmark's initial state, the engine's and the floor's alike: N particles of diameter 1
+//! at packing fraction η in a periodic box, Maxwell velocities at kT = 1 — disks on a
+//! triangular lattice, spheres on a simple cubic one (mechanically unstable: it melts within
+//! a few collisions per particle, so a fluid is timed) up to η = 0.5, and on fcc above.
 
 use crate::engine::init::{InitError, Placement, Species, Velocities, box_for_packing_fraction, initial_particles};
 use crate::engine::{Boundary, Particle, SetupError, SimBox};
@@ -43,27 +45,35 @@ impl fmt::Display for BenchError {
 
 impl std::error::Error for BenchError {}
 
-/// The initial state of a point (see the module documentation).
-pub fn initial_state(n: usize, eta: f64, seed: u64) -> Result<(Vec<Particle<2>>, SimBox<2>), BenchError> {
-    // Close packing of equal disks: π/(2√3) ≈ 0.9069.
-    if !(eta > 0.0 && eta < 0.9069) {
-        return Err(BenchError::Option {
-            flag: "eta",
-            value: eta.to_string(),
-            allowed: "the packing fraction must lie in (0, 0.9069) (close packing is π/(2√3))",
-        });
+/// The initial state of a point in `D` dimensions (see the module documentation).
+pub fn initial_state<const D: usize>(
+    n: usize,
+    eta: f64,
+    seed: u64,
+) -> Result<(Vec<Particle<D>>, SimBox<D>), BenchError> {
+    let (close, allowed) = match D {
+        2 => (0.9069, "the packing fraction must lie in (0, 0.9069) (close packing is π/(2√3))"),
+        _ => (0.7405, "the packing fraction must lie in (0, 0.7405) (close packing is π/√18)"),
+    };
+    if !(eta > 0.0 && eta < close) {
+        return Err(BenchError::Option { flag: "eta", value: eta.to_string(), allowed });
     }
     if n < 2 {
         return Err(BenchError::Option {
             flag: "n",
             value: n.to_string(),
-            allowed: "a benchmark needs at least 2 disks",
+            allowed: "a benchmark needs at least 2 particles",
         });
     }
     crate::run::Limits::for_this_machine().check_memory("--n", n, 0.0).map_err(BenchError::Limit)?;
     let species = vec![Species { count: n, radius: 0.5, mass: 1.0 }];
-    let sim_box = box_for_packing_fraction(&species, eta, [Boundary::Periodic; 2], Placement::Triangular, None);
-    let particles = initial_particles(&species, &sim_box, Placement::Triangular, Velocities::Maxwell, 1.0, seed)
-        .map_err(BenchError::Init)?;
+    let placement = match D {
+        2 => Placement::Triangular,
+        _ if eta <= 0.5 => Placement::SimpleCubic,
+        _ => Placement::Fcc,
+    };
+    let sim_box = box_for_packing_fraction(&species, eta, [Boundary::Periodic; D], placement, None);
+    let particles =
+        initial_particles(&species, &sim_box, placement, Velocities::Maxwell, 1.0, seed).map_err(BenchError::Init)?;
     Ok((particles, sim_box))
 }

@@ -5,7 +5,8 @@
 //! writes, observed by the run's own observers and its own ([`crate::observe::Observer`]),
 //! turned into [`Check`]s against the formulas of [`crate::theory`] with tolerances that say
 //! why. Every experiment takes [`Options`] (`quick` for a CI-sized run, a seed, an output
-//! directory) and returns an [`ExperimentResult`]; `collide validate` runs them all
+//! directory, the dimension: 2 for disks, 3 for spheres) and returns an [`ExperimentResult`]
+//! of the same layout in both dimensions; `collide validate` runs them all, in both dimensions
 //! ([`report`]), `collide experiment NAME` one, and each registered in Cargo.toml is also a
 //! binary (`cargo run --release --bin <name>`, through [`main_for`]). What each checks, and
 //! against which reference, is specified in `docs/experiments.md`.
@@ -131,15 +132,64 @@ pub struct Options {
     pub quick: bool,
     /// Seed of the initial states.
     pub seed: u64,
-    /// Where `<name>/result.json` and the plots go.
+    /// Where `<name>/result.json` (`<name>_3d/` in 3D) and the plots go.
     pub out: PathBuf,
+    /// 2 (disks) or 3 (spheres).
+    pub dimension: usize,
+}
+
+impl Options {
+    /// Disks, report size, seed 1, into `out`.
+    pub fn new(out: impl Into<PathBuf>) -> Options {
+        Options { quick: false, seed: 1, out: out.into(), dimension: 2 }
+    }
+
+    /// The directory name of experiment `name` in this dimension: `name` for disks,
+    /// `name_3d` for spheres.
+    pub fn slug(&self, name: &str) -> String {
+        slug(name, self.dimension)
+    }
+
+    /// The experiment's own directory under `out`, created for its plots.
+    pub fn plot_dir(&self, name: &str) -> Result<PathBuf, ExperimentError> {
+        Ok(ExperimentResult::made_dir(&self.out, &self.slug(name))?)
+    }
+
+    /// A result of experiment `name` run with these options.
+    pub fn result(
+        &self,
+        name: &str,
+        parameters: serde_json::Value,
+        data: serde_json::Value,
+        checks: Vec<Check>,
+        plots: Vec<String>,
+    ) -> ExperimentResult {
+        ExperimentResult {
+            name: name.into(),
+            dimension: self.dimension,
+            quick: self.quick,
+            seed: self.seed,
+            parameters,
+            data,
+            checks,
+            plots,
+        }
+    }
+}
+
+/// The directory name of experiment `name` in dimension `d` (see [`Options::slug`]).
+pub fn slug(name: &str, d: usize) -> String {
+    if d == 2 { name.to_string() } else { format!("{name}_{d}d") }
 }
 
 /// What an experiment produced.
 #[derive(Clone, Debug, Serialize, Deserialize)]
 pub struct ExperimentResult {
-    /// The experiment's name (its binary and directory).
+    /// The experiment's name (its binary; its directory in 2D).
     pub name: String,
+    /// 2 (disks) or 3 (spheres).
+    #[serde(default = "two")]
+    pub dimension: usize,
     /// Whether this was the quick version.
     pub quick: bool,
     /// The seed.
@@ -160,14 +210,14 @@ impl ExperimentResult {
         self.checks.iter().all(|c| c.pass)
     }
 
-    /// The experiment's own directory under `out`.
-    pub fn dir(out: &Path, name: &str) -> PathBuf {
-        out.join(name)
+    /// The experiment's own directory under `out` (named by its [`slug`]).
+    pub fn dir(out: &Path, slug: &str) -> PathBuf {
+        out.join(slug)
     }
 
-    /// The experiment's own directory under `out`, created for its plots.
-    pub fn plot_dir(out: &Path, name: &str) -> Result<PathBuf, ExperimentError> {
-        Ok(ExperimentResult::made_dir(out, name)?)
+    /// Its directory name: the experiment's, with `_3d` for spheres.
+    pub fn slug(&self) -> String {
+        slug(&self.name, self.dimension)
     }
 
     /// The experiment's own directory under `out`, created.
@@ -179,10 +229,14 @@ impl ExperimentResult {
 
     /// Writes `result.json` (atomically) into the experiment's directory.
     pub fn write(&self, out: &Path) -> Result<(), OutputError> {
-        let dir = ExperimentResult::made_dir(out, &self.name)?;
+        let dir = ExperimentResult::made_dir(out, &self.slug())?;
         let text = serde_json::to_string_pretty(self).expect("results serialise");
         write_atomic(&dir.join("result.json"), text.as_bytes())
     }
+}
+
+fn two() -> usize {
+    2
 }
 
 /// An experiment's entry point.
@@ -201,15 +255,18 @@ pub struct ExperimentArgs {
     /// Output directory.
     #[arg(long, default_value = "lab-out")]
     pub out: PathBuf,
+    /// 2 (disks) or 3 (spheres).
+    #[arg(long, default_value_t = 2, value_parser = clap::value_parser!(u8).range(2..=3))]
+    pub dimension: u8,
 }
 
 impl From<ExperimentArgs> for Options {
     fn from(args: ExperimentArgs) -> Options {
-        Options { quick: args.quick, seed: args.seed, out: args.out }
+        Options { quick: args.quick, seed: args.seed, out: args.out, dimension: args.dimension as usize }
     }
 }
 
-/// `main` of an experiment binary: parses `--quick`, `--seed`, `--out`, runs, writes, prints
+/// `main` of an experiment binary: parses `--quick`, `--seed`, `--out`, `--dimension`, runs, writes, prints
 /// the verdict table, and exits 1 if a check fails (2 on an error).
 pub fn main_for(name: &str, experiment: Experiment) -> ExitCode {
     use clap::Parser;
@@ -229,8 +286,8 @@ pub fn run_one(name: &str, experiment: Experiment, options: &Options) -> ExitCod
             // Writes that fail (stdout closed, e.g. piped into `head`) are not errors of the run.
             use std::io::Write as _;
             let mut stdout = std::io::stdout();
-            let _ = write!(stdout, "{}", check::table(name, &result.checks));
-            let _ = writeln!(stdout, "results in {}", ExperimentResult::dir(&options.out, name).display());
+            let _ = write!(stdout, "{}", check::table(&result.slug(), &result.checks));
+            let _ = writeln!(stdout, "results in {}", ExperimentResult::dir(&options.out, &result.slug()).display());
             if result.passed() { ExitCode::SUCCESS } else { ExitCode::FAILURE }
         }
         Err(e) => {

@@ -11,6 +11,7 @@ pub fn numerics(options: &Options) -> ExperimentResult {
     let report = quadratic::reference::check_all();
     ExperimentResult {
         name: "numerics".into(),
+        dimension: 2,
         quick: options.quick,
         seed: options.seed,
         parameters: serde_json::json!({ "cases": report.cases }),
@@ -68,7 +69,7 @@ pub fn write_report(results: &[ExperimentResult], options: &Options) -> Result<(
         format!("# collide validation report\n\n{header}\n\n| experiment | checks | verdict |\n|---|---|---|\n");
     for r in results {
         let ok = r.checks.iter().filter(|c| c.pass).count();
-        writeln!(md, "| {} | {ok}/{} | {} |", r.name, r.checks.len(), if r.passed() { "PASS" } else { "FAIL" })
+        writeln!(md, "| {} | {ok}/{} | {} |", r.slug(), r.checks.len(), if r.passed() { "PASS" } else { "FAIL" })
             .unwrap();
     }
     let mut html = format!(
@@ -84,19 +85,19 @@ pub fn write_report(results: &[ExperimentResult], options: &Options) -> Result<(
         write!(
             html,
             "<tr><td><a href=\"#{0}\">{0}</a></td><td>{ok}/{1}</td><td class=\"{class}\">{verdict}</td></tr>",
-            r.name,
+            r.slug(),
             r.checks.len()
         )
         .unwrap();
     }
     html.push_str("</table>");
     for r in results {
-        writeln!(md, "\n## {}\n\n| check | measured | error | expected | verdict | why this tolerance |\n|---|---|---|---|---|---|", r.name)
+        writeln!(md, "\n## {}\n\n| check | measured | error | expected | verdict | why this tolerance |\n|---|---|---|---|---|---|", r.slug())
             .unwrap();
         write!(
             html,
             "<h2 id=\"{0}\">{0}</h2><table><tr><th>check</th><th>measured</th><th>error</th><th>expected</th><th>verdict</th><th>why this tolerance</th></tr>",
-            r.name
+            r.slug()
         )
         .unwrap();
         for c in &r.checks {
@@ -125,8 +126,8 @@ pub fn write_report(results: &[ExperimentResult], options: &Options) -> Result<(
         }
         html.push_str("</table>");
         for plot in &r.plots {
-            writeln!(md, "\n![{plot}]({}/{plot})", r.name).unwrap();
-            let path = ExperimentResult::dir(&options.out, &r.name).join(plot);
+            writeln!(md, "\n![{plot}]({}/{plot})", r.slug()).unwrap();
+            let path = ExperimentResult::dir(&options.out, &r.slug()).join(plot);
             let svg = std::fs::read_to_string(&path).map_err(crate::run::rundir::at(&path))?;
             // Inline: the page is self-contained.
             write!(html, "<figure>{}</figure>", svg.trim_start_matches("<?xml version=\"1.0\" encoding=\"UTF-8\"?>"))
@@ -141,15 +142,19 @@ pub fn write_report(results: &[ExperimentResult], options: &Options) -> Result<(
     Ok(())
 }
 
-/// Runs the numerics check and every experiment, writes their results and the report, and
-/// returns the results (`progress` hears each experiment's name as it starts).
+/// Runs the numerics check and every experiment in both dimensions (disks, then spheres),
+/// writes their results and the report, and returns the results (`progress` hears each
+/// experiment's directory name as it starts).
 pub fn validate(options: &Options, mut progress: impl FnMut(&str)) -> Result<Vec<ExperimentResult>, ExperimentError> {
     let mut results = vec![numerics(options)];
-    for (name, experiment) in EXPERIMENTS {
-        progress(name);
-        let result = experiment(options)?;
-        result.write(&options.out)?;
-        results.push(result);
+    for dimension in [2, 3] {
+        let options = Options { dimension, ..options.clone() };
+        for (name, experiment) in EXPERIMENTS {
+            progress(&options.slug(name));
+            let result = experiment(&options)?;
+            result.write(&options.out)?;
+            results.push(result);
+        }
     }
     write_report(&results, options)?;
     Ok(results)

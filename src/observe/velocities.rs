@@ -12,9 +12,10 @@
 //!   a monotone map of the speeds, so the same statistic);
 //! * `H − H_eq`, the Kullback–Leibler divergence of the speed histogram (bins 0.1 wide up to
 //!   `u = 5`, the tail folded into the last) from the Maxwellian's, less the histogram bias
-//!   `(K − 1)/(2N)` (K occupied bins), with the standard deviation `√(2(K − 1))/(2N)` a
-//!   Maxwellian's would have (`2N·KL` is asymptotically χ² with `K − 1` degrees of freedom)
-//!   ([`h_function`]);
+//!   `(K − 1)/(2N)`, with the standard deviation `√(2(K − 1))/(2N)` a Maxwellian's would have
+//!   (`2N·KL` is asymptotically χ² with `K − 1` degrees of freedom). The asymptotics hold
+//!   where every bin expects at least 5 speeds, so sparse bins at either end are merged with
+//!   their neighbours first, and K counts the merged bins ([`h_function`]);
 //! * the Sonine coefficient `a₂ = d/(d + 2)·⟨u⁴⟩/⟨u²⟩² − 1` (0 for a Maxwellian, −½ for
 //!   equal speeds in 2D) with its standard error for a Maxwellian by the delta method
 //!   (`1/√N` in 2D) ([`sonine_a2`]);
@@ -185,24 +186,41 @@ pub fn maxwell_bin_probabilities(edges: &[f64], d: usize) -> Vec<f64> {
     (0..k).map(|i| if i + 1 == k { 1.0 - cdf(edges[i]) } else { cdf(edges[i + 1]) - cdf(edges[i]) }).collect()
 }
 
+/// The fewest speeds a merged bin of [`h_function`] expects.
+pub const MIN_EXPECTED: f64 = 5.0;
+
 /// `H − H_eq = KL(p ‖ Maxwellian)` from a histogram of the reduced speeds `u` in `d`
-/// dimensions, corrected for the histogram bias `(K − 1)/(2N)` (K occupied bins), and its
-/// standard deviation `√(2(K − 1))/(2N)` for a true Maxwellian.
+/// dimensions, corrected for the histogram bias `(K − 1)/(2N)`, and its standard deviation
+/// `√(2(K − 1))/(2N)` for a true Maxwellian. The bins of [`speed_bins`] are merged in order
+/// until each expects at least [`MIN_EXPECTED`] speeds (a short remainder joins the last
+/// group): K is the number of merged bins. (Sparse bins — the slow end in 3D, the tail in
+/// both dimensions — otherwise bias the plug-in divergence upwards by more than (K − 1)/(2N).)
 pub fn h_function(u: &[f64], d: usize) -> (f64, f64) {
     let edges = speed_bins();
     let counts = histogram(u, &edges);
     let q = maxwell_bin_probabilities(&edges, d);
     let n = u.len() as f64;
-    let mut kl = 0.0;
-    let mut occupied = 0usize;
+    let mut groups: Vec<(usize, f64)> = Vec::new();
+    let mut open = (0usize, 0.0);
     for (c, q) in counts.iter().zip(&q) {
-        if *c > 0 {
-            let p = *c as f64 / n;
-            kl += p * (p / q).ln();
-            occupied += 1;
+        open = (open.0 + c, open.1 + q);
+        if open.1 * n >= MIN_EXPECTED {
+            groups.push(open);
+            open = (0, 0.0);
         }
     }
-    let k = occupied.max(1) as f64;
+    match groups.last_mut() {
+        Some(last) => *last = (last.0 + open.0, last.1 + open.1),
+        None => groups.push(open),
+    }
+    let mut kl = 0.0;
+    for &(c, q) in &groups {
+        if c > 0 {
+            let p = c as f64 / n;
+            kl += p * (p / q).ln();
+        }
+    }
+    let k = groups.len() as f64;
     (kl - (k - 1.0) / (2.0 * n), (2.0 * (k - 1.0)).sqrt() / (2.0 * n))
 }
 
@@ -274,5 +292,34 @@ mod tests {
         assert!(h_function(&u, 3).0.abs() < 0.01);
         // The 2D CDF would call these far from equilibrium.
         assert!(ks_distance(&u, 2) > 0.1);
+    }
+
+    /// H − H_eq is calibrated: over 300 seeded Maxwellian samples of N = 4000 speeds in 2D and
+    /// in 3D, its mean in units of its stated standard deviation is 0 within 4 standard errors
+    /// (4/√300 = 0.23) and its spread is 1 within 25 %. (Without the merging of sparse bins the
+    /// 3D mean sits at about +1.2 standard deviations: a relaxed gas would fail a 3σ check one
+    /// time in ten.)
+    #[test]
+    fn the_h_function_is_calibrated_for_maxwellian_samples() {
+        use rand::SeedableRng;
+        use rand::rngs::Xoshiro256PlusPlus;
+        use rand_distr::{Distribution, Normal};
+        let normal = Normal::<f64>::new(0.0, 1.0).unwrap();
+        for d in [2usize, 3] {
+            let mut rng = Xoshiro256PlusPlus::seed_from_u64(11 + d as u64);
+            let z: Vec<f64> = (0..300)
+                .map(|_| {
+                    let u: Vec<f64> = (0..4000)
+                        .map(|_| (0..d).map(|_| normal.sample(&mut rng).powi(2)).sum::<f64>().sqrt())
+                        .collect();
+                    let (h, sd) = h_function(&u, d);
+                    h / sd
+                })
+                .collect();
+            let mean = z.iter().sum::<f64>() / z.len() as f64;
+            let spread = (z.iter().map(|x| (x - mean).powi(2)).sum::<f64>() / (z.len() - 1) as f64).sqrt();
+            assert!(mean.abs() < 4.0 / (z.len() as f64).sqrt(), "{d}D: mean {mean}");
+            assert!((spread - 1.0).abs() < 0.25, "{d}D: spread {spread}");
+        }
     }
 }
