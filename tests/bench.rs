@@ -17,8 +17,8 @@ fn bench_point_table_and_chart() {
     // Both neighbourhoods can be asked for; the point records which one ran, and both see
     // the same collisions (bit-identical trajectories), so the same event counts but for
     // the neighbourhood updates themselves.
-    let lists = measure(300, 0.6, Neighbourhood::Lists, 1, 5_000, 1).unwrap();
-    let p = measure(300, 0.6, Neighbourhood::Grid, 1, 5_000, 1).unwrap();
+    let lists = measure(2, 300, 0.6, Neighbourhood::Lists, 1, 5_000, 1).unwrap();
+    let p = measure(2, 300, 0.6, Neighbourhood::Grid, 1, 5_000, 1).unwrap();
     assert!(lists.lists && !p.lists && lists.neighbourhood == Neighbourhood::Lists);
     assert_eq!((lists.events_by_kind.pair, lists.events_by_kind.wall), (p.events_by_kind.pair, p.events_by_kind.wall));
     assert_ne!(lists.events_by_kind.rebuild, p.events_by_kind.rebuild);
@@ -29,7 +29,7 @@ fn bench_point_table_and_chart() {
     let (floor, fraction) = (p.floor_collisions_per_second.unwrap(), p.fraction_of_floor.unwrap());
     assert!(floor > 0.0 && (fraction - p.collisions_per_second / floor).abs() <= 1e-12 * fraction);
     let md = markdown(&[p.clone()], "collide bench --quick", "test machine");
-    assert!(md.contains("| 300 | 0.6 | grid |") && md.contains("test machine") && md.contains("collide bench --quick"));
+    assert!(md.contains("| 2 | 300 | 0.6 | grid |") && md.contains("test machine") && md.contains("collide bench --quick"));
     assert!(md.contains(&format!("| {:.1} % |", 100.0 * fraction)), "{md}");
     let dir = out("bench-chart");
     std::fs::create_dir_all(&dir).unwrap();
@@ -37,10 +37,22 @@ fn bench_point_table_and_chart() {
     let mut q = p.clone();
     q.n_particles = 3_000;
     q.packing_fraction = 0.3;
-    let c = chart(&[p.clone(), q.clone(), p.clone(), q]);
+    // Spheres: their own series, without a floor.
+    let s = measure(3, 500, 0.45, Neighbourhood::Auto, 1, 5_000, 1).unwrap();
+    assert_eq!((s.dimension, s.events_by_kind.pair), (3, 5_000));
+    assert!(s.floor_collisions_per_second.is_none() && !s.lists);
+    assert!(markdown(&[s.clone()], "c", "m").contains("| 3 | 500 | 0.45 | grid |"));
+    let c = chart(&[p.clone(), q.clone(), p.clone(), q, s]);
     let names: Vec<&str> = c.series.iter().map(|s| s.label.as_str()).collect();
-    assert_eq!(names, ["η = 0.3", "floor, η = 0.3", "η = 0.6", "floor, η = 0.6"]);
+    assert_eq!(
+        names,
+        ["disks, η = 0.3", "floor, disks, η = 0.3", "disks, η = 0.6", "floor, disks, η = 0.6", "spheres, η = 0.45"]
+    );
     collide::lab::plot::draw(&chart(&[p]), &dir.join("c.svg")).unwrap();
     let svg = std::fs::read_to_string(dir.join("c.svg")).unwrap();
-    assert!(svg.contains("log₁₀ N") && svg.contains("floor, η = 0.6"));
+    assert!(svg.contains("log₁₀ N") && svg.contains("floor, disks, η = 0.6"));
+    // A dimension other than 2 or 3, and a packing fraction past close packing of spheres.
+    assert!(measure(4, 500, 0.3, Neighbourhood::Auto, 1, 10, 1).unwrap_err().to_string().contains("--dimension 4"));
+    let err = measure(3, 500, 0.75, Neighbourhood::Auto, 1, 10, 1).unwrap_err().to_string();
+    assert!(err.contains("π/√18"), "{err}");
 }
