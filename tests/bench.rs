@@ -29,7 +29,9 @@ fn bench_point_table_and_chart() {
     let (floor, fraction) = (p.floor_collisions_per_second.unwrap(), p.fraction_of_floor.unwrap());
     assert!(floor > 0.0 && (fraction - p.collisions_per_second / floor).abs() <= 1e-12 * fraction);
     let md = markdown(&[p.clone()], "collide bench --quick", "test machine");
-    assert!(md.contains("| 2 | 300 | 0.6 | grid |") && md.contains("test machine") && md.contains("collide bench --quick"));
+    assert!(
+        md.contains("| 2 | 300 | 0.6 | grid |") && md.contains("test machine") && md.contains("collide bench --quick")
+    );
     assert!(md.contains(&format!("| {:.1} % |", 100.0 * fraction)), "{md}");
     let dir = out("bench-chart");
     std::fs::create_dir_all(&dir).unwrap();
