@@ -1,12 +1,13 @@
 //! Steady-state collisions per second of the engine (setup and warm-up excluded): N = 10³,
-//! 10⁴, 10⁵ disks at packing fractions 0.3 and 0.65, periodic box. Each iteration processes
-//! events until one more pair collision has happened, so criterion's throughput is in
-//! collisions per second.
+//! 10⁴, 10⁵ disks at packing fractions 0.3 and 0.65 (`engine/collisions`) and spheres at 0.3
+//! and 0.45 (`engine/collisions_3d`), periodic box, from the benchmark report's lattice
+//! starts. Each iteration processes events until one more pair collision has happened, so
+//! criterion's throughput is in collisions per second.
 //!
-//! `engine/floor` times the hardware's floor (`collide::bench::floor`: two disks moved,
-//! bounced and re-predicted against eight fixed neighbours, no queue) at N = 10⁴ and 10⁵,
-//! η = 0.65, per collision, without and with its lookahead: what the engine's rate is a
-//! fraction of.
+//! `engine/floor` times the hardware's floor (`collide::bench::floor`: two particles moved,
+//! bounced and re-predicted against fixed neighbours — eight disks, or sixteen spheres — no
+//! queue) at N = 10⁴ and 10⁵, disks at η = 0.65 and spheres at 0.45, per collision, without
+//! and with its lookahead: what the engine's rate is a fraction of.
 //!
 //! `engine/parts` times pieces of one collision's work at N = 10⁴, η = 0.65, to show where
 //! the time goes: `bracket_pair` over every pair of a warmed-up state closer than 1.8σ (per
@@ -31,12 +32,31 @@ fn warmed_up(n: usize, eta: f64) -> Simulation<2> {
     let species = vec![Species { count: n, radius: 0.5, mass: 1.0 }];
     let sim_box = box_for_packing_fraction(&species, eta, [Boundary::Periodic; 2], Placement::Triangular, None);
     let particles = initial_particles(&species, &sim_box, Placement::Triangular, Velocities::Maxwell, 1.0, 1).unwrap();
-    let mut sim = Simulation::new(particles, sim_box).unwrap();
+    relaxed(Simulation::new(particles, sim_box).unwrap(), n)
+}
+
+/// Spheres from the benchmark report's start (`collide::bench::state::initial_state`).
+fn warmed_up_3d(n: usize, eta: f64) -> Simulation<3> {
+    let (particles, sim_box) = collide::bench::state::initial_state::<3>(n, eta, 1).unwrap();
+    relaxed(Simulation::new(particles, sim_box).unwrap(), n)
+}
+
+fn relaxed<const D: usize>(mut sim: Simulation<D>, n: usize) -> Simulation<D> {
     // As `collide bench` does: the lattice relaxes (see `collide::bench::WARMUP`).
     while sim.counts().pair < collide::bench::WARMUP * n as u64 {
         sim.step().unwrap();
     }
     sim
+}
+
+/// Iterations of one more pair collision each.
+fn collisions<const D: usize>(sim: &mut Simulation<D>, iters: u64) -> Duration {
+    let start = Instant::now();
+    let target = sim.counts().pair + iters;
+    while sim.counts().pair < target {
+        sim.step().unwrap();
+    }
+    start.elapsed()
 }
 
 fn engine(c: &mut Criterion) {
@@ -46,14 +66,18 @@ fn engine(c: &mut Criterion) {
         for eta in [0.3, 0.65] {
             let mut sim = warmed_up(n, eta);
             group.bench_function(BenchmarkId::new(format!("eta={eta}"), n), |b| {
-                b.iter_custom(|iters| {
-                    let start = Instant::now();
-                    let target = sim.counts().pair + iters;
-                    while sim.counts().pair < target {
-                        sim.step().unwrap();
-                    }
-                    start.elapsed()
-                })
+                b.iter_custom(|iters| collisions(&mut sim, iters))
+            });
+        }
+    }
+    group.finish();
+    let mut group = c.benchmark_group("engine/collisions_3d");
+    group.throughput(Throughput::Elements(1));
+    for n in [1_000, 10_000, 100_000] {
+        for eta in [0.3, 0.45] {
+            let mut sim = warmed_up_3d(n, eta);
+            group.bench_function(BenchmarkId::new(format!("eta={eta}"), n), |b| {
+                b.iter_custom(|iters| collisions(&mut sim, iters))
             });
         }
     }
@@ -68,13 +92,21 @@ fn floor(c: &mut Criterion) {
     for n in [10_000, 100_000] {
         // Both loops, as `collide bench` times them (it reports the faster).
         for lookahead in [false, true] {
-            let mut floor = collide::bench::floor::Floor::new(n, 0.65, 1).unwrap();
+            let loop_name = if lookahead { "lookahead" } else { "plain" };
+            let mut disks = collide::bench::floor::Floor::<2>::new(n, 0.65, 1).unwrap();
             let mut rng = Xoshiro256PlusPlus::seed_from_u64(2);
-            let name = if lookahead { "eta=0.65/lookahead" } else { "eta=0.65/plain" };
-            group.bench_function(BenchmarkId::new(name, n), |b| {
+            group.bench_function(BenchmarkId::new(format!("eta=0.65/{loop_name}"), n), |b| {
                 b.iter_custom(|iters| {
                     let start = Instant::now();
-                    floor.run(&mut rng, iters, lookahead);
+                    disks.run(&mut rng, iters, lookahead);
+                    start.elapsed()
+                })
+            });
+            let mut spheres = collide::bench::floor::Floor::<3>::new(n, 0.45, 1).unwrap();
+            group.bench_function(BenchmarkId::new(format!("3d/eta=0.45/{loop_name}"), n), |b| {
+                b.iter_custom(|iters| {
+                    let start = Instant::now();
+                    spheres.run(&mut rng, iters, lookahead);
                     start.elapsed()
                 })
             });

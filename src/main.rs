@@ -66,6 +66,8 @@ enum Command {
     /// The hardware's floor for one point, without and with its lookahead (JSON lines).
     #[command(hide = true)]
     BenchFloor {
+        #[arg(long, default_value_t = 2, value_parser = clap::value_parser!(u8).range(2..=3))]
+        dimension: u8,
         #[arg(long)]
         n: usize,
         #[arg(long)]
@@ -230,8 +232,12 @@ fn run(cli: Cli) -> Result<ExitCode> {
             say!("{}", serde_json::to_string(&point)?);
             Ok(ExitCode::SUCCESS)
         }
-        Command::BenchFloor { n, eta, timed, seed } => {
-            for point in collide::bench::floor::measure_both(n, eta, 2 * n as u64, timed, seed)? {
+        Command::BenchFloor { dimension, n, eta, timed, seed } => {
+            let points = match dimension {
+                3 => collide::bench::floor::measure_both::<3>(n, eta, 2 * n as u64, timed, seed)?,
+                _ => collide::bench::floor::measure_both::<2>(n, eta, 2 * n as u64, timed, seed)?,
+            };
+            for point in points {
                 say!("{}", serde_json::to_string(&point)?);
             }
             Ok(ExitCode::SUCCESS)

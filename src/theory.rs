@@ -27,6 +27,10 @@ pub const ETA_CP_3D: f64 = 0.740_480_489_693_061_1;
 /// Feder & Jøssang, J. Stat. Phys. 44, 793 (1986)).
 pub const RSA_JAMMING_2D: f64 = 0.547;
 
+/// The random sequential addition (jamming) limit of equal spheres, φ∞ = 0.384130(2)
+/// (Torquato, Uche & Stillinger, Phys. Rev. E 74, 061308 (2006)).
+pub const RSA_JAMMING_3D: f64 = 0.3841;
+
 /// Reduced virial coefficients b₂…b₁₀ of hard disks, `Z = 1 + Σ b_k η^(k−1)` (Clisby &
 /// McCoy, J. Stat. Phys. 122, 15 (2006), Table 1, D = 2).
 pub const VIRIAL_B_2D: [f64; 9] = [2.0, 3.128018, 4.257854, 5.336897, 6.36296, 7.35186, 8.31910, 9.27214, 10.2163];

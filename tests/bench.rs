@@ -39,16 +39,24 @@ fn bench_point_table_and_chart() {
     let mut q = p.clone();
     q.n_particles = 3_000;
     q.packing_fraction = 0.3;
-    // Spheres: their own series, without a floor.
+    // Spheres: their own series, with a floor of their own.
     let s = measure(3, 500, 0.45, Neighbourhood::Auto, 1, 5_000, 1).unwrap();
     assert_eq!((s.dimension, s.events_by_kind.pair), (3, 5_000));
-    assert!(s.floor_collisions_per_second.is_none() && !s.lists);
+    let (floor, fraction) = (s.floor_collisions_per_second.unwrap(), s.fraction_of_floor.unwrap());
+    assert!(floor > 0.0 && (fraction - s.collisions_per_second / floor).abs() <= 1e-12 * fraction && !s.lists);
     assert!(markdown(&[s.clone()], "c", "m").contains("| 3 | 500 | 0.45 | grid |"));
     let c = chart(&[p.clone(), q.clone(), p.clone(), q, s]);
     let names: Vec<&str> = c.series.iter().map(|s| s.label.as_str()).collect();
     assert_eq!(
         names,
-        ["disks, η = 0.3", "floor, disks, η = 0.3", "disks, η = 0.6", "floor, disks, η = 0.6", "spheres, η = 0.45"]
+        [
+            "disks, η = 0.3",
+            "floor, disks, η = 0.3",
+            "disks, η = 0.6",
+            "floor, disks, η = 0.6",
+            "spheres, η = 0.45",
+            "floor, spheres, η = 0.45"
+        ]
     );
     collide::lab::plot::draw(&chart(&[p]), &dir.join("c.svg")).unwrap();
     let svg = std::fs::read_to_string(dir.join("c.svg")).unwrap();

@@ -61,8 +61,8 @@ pub struct BenchPoint {
     #[serde(default)]
     pub huge_page_bytes: Option<u64>,
     /// The hardware's floor for the same N and η on this machine ([`floor`]: move two
-    /// disks, bounce, re-predict both against eight fixed neighbours; no queue, no list
-    /// upkeep, no exact times), collisions per second — measured in the same process after
+    /// particles, bounce, re-predict both against fixed neighbours — eight disks or sixteen
+    /// spheres; no queue, no list upkeep, no exact times), collisions per second — measured in the same process after
     /// the engine, with as many timed collisions.
     #[serde(default)]
     pub floor_collisions_per_second: Option<f64>,
@@ -130,9 +130,10 @@ fn measure_in<const D: usize>(
     // Read before the floor allocates; the engine's memory goes first.
     let (peak_rss_bytes, huge_page_bytes) = (peak_rss_bytes(), crate::engine::internals::huge_page_bytes());
     drop(sim);
-    // (The floor needs a full row of neighbours: none below 2·WIDTH disks; it is of disks.)
-    let floor =
-        (D == 2 && n >= 2 * floor::WIDTH).then(|| floor::measure(n, eta, 2 * n as u64, timed, seed)).transpose()?;
+    // (The floor needs full rows of neighbours: none below two particles' worth of rows.)
+    let floor = (n >= 2 * floor::rows(D) * floor::WIDTH)
+        .then(|| floor::measure::<D>(n, eta, 2 * n as u64, timed, seed))
+        .transpose()?;
     let collisions_per_second = timed as f64 / seconds;
     Ok(BenchPoint {
         dimension: D,
@@ -229,9 +230,10 @@ pub fn markdown(points: &[BenchPoint], command: &str, machine: &str) -> String {
         ));
     }
     md.push_str(
-        "\nThe floor: the same N and η with nothing but moving two disks, bouncing them and \
-         re-predicting both against eight fixed neighbours with the textbook formula (no queue, \
-         no list upkeep, no exact times; `collide::bench::floor`), measured in the same process.\n",
+        "\nThe floor: the same N and η with nothing but moving two particles, bouncing them and \
+         re-predicting both against fixed neighbours (eight disks, sixteen spheres) with the textbook \
+         formula (no queue, no list upkeep, no exact times; `collide::bench::floor`), measured in the \
+         same process.\n",
     );
     md
 }

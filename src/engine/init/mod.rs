@@ -17,7 +17,7 @@ mod lattice;
 mod random;
 
 use super::geometry::{Boundary, Particle, SimBox};
-use crate::theory::RSA_JAMMING_2D;
+use crate::theory::{RSA_JAMMING_2D, RSA_JAMMING_3D};
 use nalgebra::{SVector, Vector2};
 use rand::rngs::Xoshiro256PlusPlus;
 use rand::seq::SliceRandom;
@@ -100,8 +100,10 @@ pub enum Velocities {
 #[non_exhaustive]
 #[derive(Clone, Debug, PartialEq)]
 pub enum InitError {
-    /// Random placement gave up: no room was found for a disk in 10⁴ tries.
+    /// Random placement gave up: no room was found for a particle in 10⁴ tries.
     CannotPlace {
+        /// The dimension of the run (what the message calls a disk or a sphere).
+        dimension: usize,
         /// Disks placed before giving up.
         placed: usize,
         /// Disks requested.
@@ -115,7 +117,7 @@ pub enum InitError {
         /// The packing fraction asked for.
         requested_eta: f64,
         /// The packing fraction up to which a lattice of this dimension holds these species
-        /// with its sites a largest diameter apart ([`lattice_limit`]; none in 3D yet).
+        /// with its sites a largest diameter apart ([`lattice_limit`]).
         lattice_fits_up_to: Option<f64>,
     },
     /// A lattice placement asked for in a dimension it does not exist in.
@@ -158,6 +160,7 @@ impl fmt::Display for InitError {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         match self {
             InitError::CannotPlace {
+                dimension,
                 placed,
                 requested,
                 species,
@@ -166,19 +169,24 @@ impl fmt::Display for InitError {
                 requested_eta,
                 lattice_fits_up_to,
             } => {
+                let (particle, lattice, a_lattice, rsa) = if *dimension == 3 {
+                    ("sphere", "fcc", "an fcc", RSA_JAMMING_3D)
+                } else {
+                    ("disk", "triangular", "a triangular", RSA_JAMMING_2D)
+                };
                 write!(
                     f,
-                    "random placement found no room for disk {} of {requested} (species {species}, radius {radius}) in {} tries, at packing fraction {reached:.4} of the {requested_eta:.4} asked for (random sequential placement jams near η ≈ {RSA_JAMMING_2D} for equal disks, and gives up before): ",
+                    "random placement found no room for {particle} {} of {requested} (species {species}, radius {radius}) in {} tries, at packing fraction {reached:.4} of the {requested_eta:.4} asked for (random sequential placement jams near η ≈ {rsa} for equal {particle}s, and gives up before): ",
                     placed + 1,
                     random::TRIES
                 )?;
                 match lattice_fits_up_to {
                     Some(fits) if fits >= requested_eta => {
-                        write!(f, "use placement = \"triangular\", which holds these disks up to η ≈ {fits:.4}")
+                        write!(f, "use placement = \"{lattice}\", which holds these {particle}s up to η ≈ {fits:.4}")
                     }
                     Some(fits) => write!(
                         f,
-                        "no placement reaches it: a triangular lattice holds these disks up to η ≈ {fits:.4}, random placement got to {reached:.4}; start at or below {:.4}",
+                        "no placement reaches it: {a_lattice} lattice holds these {particle}s up to η ≈ {fits:.4}, random placement got to {reached:.4}; start at or below {:.4}",
                         fits.max(*reached)
                     ),
                     None => write!(f, "random placement got to {reached:.4}; start at or below it"),

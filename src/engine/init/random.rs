@@ -196,6 +196,7 @@ fn place<const D: usize>(
         let Some(x) = found else {
             let volume: f64 = placed.disks.iter().map(|&(_, s)| super::ball_volume::<D>(s)).sum();
             return Err(InitError::CannotPlace {
+                dimension: D,
                 placed: placed.disks.len(),
                 requested: kinds.len(),
                 species: k,
