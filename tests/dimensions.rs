@@ -1,9 +1,9 @@
-//! The product generic over the dimension: initial states, the engine against the reference,
-//! runs, checkpoints and trajectories in 3D as in 2D. (The 3D configuration key and the 3D
-//! experiments come later; here every piece is driven through the library.)
+//! The product generic over the dimension: initial states, the engine against the reference
+//! (with the grid and with neighbour lists), runs, checkpoints and trajectories in 3D as in
+//! 2D, every piece driven through the library.
 
 use collide::engine::init::{InitError, Placement, Species, Velocities, box_for_packing_fraction, initial_particles};
-use collide::engine::{Boundary, ReferenceSimulation, Simulation};
+use collide::engine::{Boundary, Neighbourhood, ReferenceSimulation, Simulation};
 use collide::run::output::xyz_frame;
 use collide::run::{Checkpoint, Config, Discard, Run, RunError, Summary};
 
@@ -67,19 +67,26 @@ fn a_run_of_spheres_conserves_and_resumes_bit_identically() {
 }
 
 /// The fast engine and the O(N²) reference give the same collisions, to the bit, for spheres
-/// in periodic and walled boxes, one size and a mixture.
+/// in periodic, walled and mixed boxes, a mixture of two sizes — with the grid and with
+/// neighbour lists (two rows a sphere) forced on.
 #[test]
 fn spheres_collide_as_the_reference_says() {
-    for (boundary, seed) in [([Boundary::Periodic; 3], 1), ([Boundary::Wall; 3], 2)] {
+    use Boundary::{Periodic as P, Wall as W};
+    let mut listed = 0;
+    for (boundary, seed) in [([P; 3], 1), ([W; 3], 2), ([P, W, P], 3)] {
         let species =
-            [Species { count: 60, radius: 0.5, mass: 1.0 }, Species { count: 60, radius: 0.3, mass: 0.4 }].to_vec();
-        let sim_box = box_for_packing_fraction::<3>(&species, 0.2, boundary, Placement::Random, None);
+            [Species { count: 100, radius: 0.5, mass: 1.0 }, Species { count: 100, radius: 0.3, mass: 0.4 }].to_vec();
+        let sim_box = box_for_packing_fraction::<3>(&species, 0.25, boundary, Placement::Random, None);
         let particles =
             initial_particles(&species, &sim_box, Placement::Random, Velocities::Maxwell, 1.0, seed).unwrap();
-        let fast = Simulation::new(particles.clone(), sim_box).unwrap();
-        let slow = ReferenceSimulation::new(particles, sim_box);
-        assert_same_collisions(fast, slow, 3000, &format!("{boundary:?}, seed {seed}"));
+        for neighbourhood in [Neighbourhood::Grid, Neighbourhood::Lists] {
+            let fast = Simulation::with_neighbourhood(particles.clone(), sim_box, neighbourhood).unwrap();
+            listed += fast.lists() as usize;
+            let slow = ReferenceSimulation::new(particles.clone(), sim_box);
+            assert_same_collisions(fast, slow, 3000, &format!("{boundary:?}, seed {seed}, {neighbourhood}"));
+        }
     }
+    assert_eq!(listed, 3, "lists were kept in {listed} of 3 boxes");
 }
 
 /// Dense crystals from fcc (and a simple cubic lattice between walls): the fast engine and
@@ -94,15 +101,43 @@ fn dense_lattice_starts_collide_as_the_reference_says() {
         (100, 0.55, [W; 3], Placement::Fcc, 4),
         (125, 0.45, [P, W, P], Placement::SimpleCubic, 5),
     ];
+    let mut listed = 0;
     for (n, eta, boundary, placement, seed) in cases {
         let species = vec![Species { count: n, radius: 0.5, mass: 1.0 }];
         let sim_box = box_for_packing_fraction::<3>(&species, eta, boundary, placement, None);
         let particles = initial_particles(&species, &sim_box, placement, Velocities::Maxwell, 1.0, seed).unwrap();
-        let fast = Simulation::new(particles.clone(), sim_box).unwrap();
-        assert_eq!(fast.check_overlaps().at, None);
-        let slow = ReferenceSimulation::new(particles, sim_box);
-        assert_same_collisions(fast, slow, 4000, &format!("{placement:?} η = {eta} {boundary:?}"));
+        for neighbourhood in [Neighbourhood::Grid, Neighbourhood::Lists] {
+            let fast = Simulation::with_neighbourhood(particles.clone(), sim_box, neighbourhood).unwrap();
+            assert_eq!(fast.check_overlaps().at, None);
+            listed += fast.lists() as usize;
+            let slow = ReferenceSimulation::new(particles.clone(), sim_box);
+            assert_same_collisions(fast, slow, 4000, &format!("{neighbourhood}, {placement:?} η = {eta} {boundary:?}"));
+        }
     }
+    assert!(listed >= 2, "lists were kept in {listed} of 3 lattices");
+}
+
+/// A dense fluid of spheres with lists (the automatic choice at η = 0.45, from a simple cubic
+/// start): a checkpoint taken mid-run (the centres and the crowded particles saved) resumes
+/// to the same bits as the run never interrupted.
+#[test]
+fn spheres_with_lists_resume_bit_identically() {
+    let text = "dimension = 3\nseed = 6\n[box]\npacking_fraction = 0.45\nboundary = \"periodic\"\n\
+                [[species]]\ncount = 512\nradius = 0.5\nmass = 1.0\n[init]\nplacement = \"simple_cubic\"\n\
+                [equilibration]\ncollisions = 20000\n[run]\ncollisions = 40000\nsample_interval = 0.2\n";
+    let config = Config::parse(text, "dense spheres").unwrap();
+    let mut run = Run::<3>::new(config.clone()).unwrap();
+    assert!(run.sim.lists());
+    let Ok(_) = run.complete(&mut Discard);
+    let whole = reproducible(run.summary());
+    assert!(whole.max_overlap.fraction <= 1e-12, "{:?}", whole.max_overlap);
+    let mut first = Run::<3>::new(config).unwrap();
+    let Ok(_) = first.equilibrate(&mut Discard);
+    let text = first.checkpoint(0).to_json();
+    let mut resumed = Run::resume(Checkpoint::<3>::from_json(text.as_bytes()).unwrap()).unwrap();
+    let Ok(_) = resumed.complete(&mut Discard);
+    assert_eq!(reproducible(resumed.summary()), whole);
+    assert_eq!(resumed.sim.particles(), run.sim.particles());
 }
 
 /// Initial states in 3D: random placement without overlap, one speed per species with

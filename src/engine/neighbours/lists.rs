@@ -5,8 +5,15 @@
 use super::Neighbourhood;
 use crate::engine::geometry::{Boundary, SimBox};
 
-/// The most neighbours a list holds (a crowded particle searches the grid).
+/// The entries of one row of a list (one 32-byte block, read by the batch kernel eight lanes
+/// at a time).
 pub const CAPACITY: usize = 8;
+
+/// Rows a particle's list spans: one in 2D, two in 3D (a dense sphere fluid has about twice
+/// the neighbours in range of a disk fluid).
+pub const fn rows_for(dimension: usize) -> usize {
+    if dimension >= 3 { 2 } else { 1 }
+}
 
 /// An unused entry (lists are packed at the front).
 pub(crate) const NONE: u32 = u32::MAX;
@@ -14,77 +21,108 @@ pub(crate) const NONE: u32 = u32::MAX;
 /// The first entry of a crowded particle's list.
 pub(crate) const CROWDED: u32 = u32::MAX - 1;
 
-/// One particle's neighbours, `NONE` after the last; `[CROWDED, ..]` for a crowded particle.
+/// One row of a list: `CAPACITY` entries. A particle's list is its `rows_for(D)` consecutive
+/// rows ([`Rows`]).
 #[derive(Clone, Copy, Debug)]
 #[repr(C, align(32))]
 pub(crate) struct List([u32; CAPACITY]);
 
 impl List {
     pub(crate) const EMPTY: List = List([NONE; CAPACITY]);
-    pub(crate) const CROWDED: List = {
-        let mut list = List::EMPTY;
-        list.0[0] = CROWDED;
-        list
-    };
+}
 
-    /// Whether the particle has more neighbours in range than a row holds (it then searches
+/// One particle's list, its rows: its neighbours, `NONE` after the last; `CROWDED` first for
+/// a crowded particle.
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct Rows<'a>(pub(crate) &'a [List]);
+
+impl<'a> Rows<'a> {
+    /// Whether the particle has more neighbours in range than its rows hold (it then searches
     /// the grid of centres instead).
     #[inline]
     pub(crate) fn crowded(&self) -> bool {
-        self.0[0] == CROWDED
+        self.0[0].0[0] == CROWDED
     }
 
-    /// The entries, members first (`NONE` after the last; `[CROWDED, ..]` when crowded).
+    /// The entries, members first (`NONE` after the last; `CROWDED` first when crowded).
     #[inline]
-    pub(crate) fn entries(&self) -> &[u32; CAPACITY] {
-        &self.0
+    pub(crate) fn entries(self) -> impl Iterator<Item = u32> + 'a {
+        self.0.iter().flat_map(|row| row.0)
     }
 
     /// The members (none when crowded).
     #[inline]
-    pub(crate) fn members(&self) -> impl Iterator<Item = usize> + '_ {
-        let skip = if self.crowded() { CAPACITY } else { 0 };
-        self.0[skip..].iter().take_while(|&&j| j != NONE).map(|&j| j as usize)
+    pub(crate) fn members(self) -> impl Iterator<Item = usize> + 'a {
+        let skip = if self.crowded() { self.0.len() * CAPACITY } else { 0 };
+        self.entries().skip(skip).take_while(|&j| j != NONE).map(|j| j as usize)
     }
 
-    /// Takes `i` out, moving the last entry into its place (no-op if crowded or absent).
-    pub(crate) fn drop(&mut self, i: u32) {
-        if self.crowded() {
-            return;
-        }
-        // Members first, then `NONE`s: count the members and find `i` without branches.
-        let (mut len, mut at) = (0, CAPACITY);
-        for (k, &j) in self.0.iter().enumerate() {
-            len += (j != NONE) as usize;
-            at = if j == i { k } else { at };
-        }
-        if at < CAPACITY {
-            self.0[at] = self.0[len - 1];
-            self.0[len - 1] = NONE;
-        }
+    /// The rows, for prefetching.
+    #[inline]
+    pub(crate) fn blocks(self) -> &'a [List] {
+        self.0
     }
+}
 
-    /// Puts `i` in; a full list becomes crowded.
-    pub(crate) fn add(&mut self, i: u32) {
-        if self.crowded() {
-            return;
-        }
-        let len = self.0.iter().filter(|&&j| j != NONE).count();
-        match len {
-            CAPACITY => *self = List::CROWDED,
-            _ => self.0[len] = i,
-        }
-    }
+/// Entry `k` of rows `rows`.
+#[inline(always)]
+fn at(rows: &mut [List], k: usize) -> &mut u32 {
+    &mut rows[k / CAPACITY].0[k % CAPACITY]
+}
 
-    /// A row holding `members`, or a crowded one if they do not fit.
-    pub(crate) fn from_members(members: &[u32]) -> List {
-        if members.len() > CAPACITY {
-            return List::CROWDED;
-        }
-        let mut list = List::EMPTY;
-        list.0[..members.len()].copy_from_slice(members);
-        list
+/// Whether `rows` are crowded.
+#[inline]
+pub(crate) fn crowded(rows: &[List]) -> bool {
+    rows[0].0[0] == CROWDED
+}
+
+/// Takes `i` out of `rows`, moving the last entry into its place (no-op if crowded or absent).
+pub(crate) fn drop(rows: &mut [List], i: u32) {
+    if crowded(rows) {
+        return;
     }
+    // Members first, then `NONE`s: count the members and find `i` without branches.
+    let full = rows.len() * CAPACITY;
+    let (mut len, mut found) = (0, full);
+    for (k, j) in rows.iter().flat_map(|row| row.0).enumerate() {
+        len += (j != NONE) as usize;
+        found = if j == i { k } else { found };
+    }
+    if found < full {
+        *at(rows, found) = *at(rows, len - 1);
+        *at(rows, len - 1) = NONE;
+    }
+}
+
+/// Puts `i` into `rows`; full rows become crowded.
+pub(crate) fn add(rows: &mut [List], i: u32) {
+    if crowded(rows) {
+        return;
+    }
+    let len = rows.iter().flat_map(|row| row.0).filter(|&j| j != NONE).count();
+    if len == rows.len() * CAPACITY {
+        set_crowded(rows);
+    } else {
+        *at(rows, len) = i;
+    }
+}
+
+/// Rows holding `members`, or crowded ones if they do not fit.
+pub(crate) fn fill(rows: &mut [List], members: &[u32]) {
+    if members.len() > rows.len() * CAPACITY {
+        set_crowded(rows);
+        return;
+    }
+    rows.fill(List::EMPTY);
+    for (k, &j) in members.iter().enumerate() {
+        *at(rows, k) = j;
+    }
+}
+
+/// Marks `rows` crowded.
+pub(crate) fn set_crowded(rows: &mut [List]) {
+    rows.fill(List::EMPTY);
+    rows[0].0[0] = CROWDED;
 }
 
 /// Lists are kept (by [`Neighbourhood::Auto`]) from this packing fraction on,
@@ -101,12 +139,23 @@ pub const LISTS_FROM: f64 = 0.63;
 /// fastest of the skins measured (`benches/HISTORY.md`).
 pub const RANGE_HOLDS: f64 = 8.4;
 
-/// The skin for lists, or `None` for the grid that follows the particles: lists only in 2D
-/// (in 3D a list of [`CAPACITY`] holds fewer than a dense fluid's neighbours), with no short
-/// periodic axis (`allow`), and for [`Neighbourhood::Auto`] from [`LISTS_FROM`] on. The skin
-/// makes the range hold [`RANGE_HOLDS`] particles, within
-/// `[reach/4, reach]`, and short enough that a range plus a skin stays under half of every
-/// periodic box length (one image of a pair in range).
+/// Spheres: lists are kept (by [`Neighbourhood::Auto`]) from this packing fraction on,
+/// `n·(π/6)·reach³`. Measured with alternating runs of both neighbourhoods at N = 10⁴
+/// (`benches/HISTORY.md`): the grid is ahead at η = 0.3, even at 0.35, lists ahead by a tenth
+/// at 0.4 and a quarter at 0.45.
+pub const LISTS_FROM_3D: f64 = 0.38;
+
+/// Spheres: the mean number of particles the list range is sized to hold, `n·(4π/3)·R³`
+/// (two rows hold 16; the fluid's first shell crowds the range beyond its mean, and a
+/// particle with more than 16 searches the grid). Of 8, 10, 12 and 14 measured at η = 0.45,
+/// 12 was the fastest (a skin of about 0.55 of a contact distance there).
+pub const RANGE_HOLDS_3D: f64 = 12.0;
+
+/// The skin for lists, or `None` for the grid that follows the particles: with no short
+/// periodic axis (`allow`), and for [`Neighbourhood::Auto`] from [`LISTS_FROM`]
+/// ([`LISTS_FROM_3D`] for spheres) on. The skin makes the range hold [`RANGE_HOLDS`]
+/// ([`RANGE_HOLDS_3D`]) particles, within `[reach/4, reach]`, and short enough that a range
+/// plus a skin stays under half of every periodic box length (one image of a pair in range).
 pub(crate) fn skin_for<const D: usize>(
     sim_box: &SimBox<D>,
     reach: f64,
@@ -114,17 +163,24 @@ pub(crate) fn skin_for<const D: usize>(
     allow: bool,
     choice: Neighbourhood,
 ) -> Option<f64> {
+    use std::f64::consts::PI;
     let density = n as f64 / sim_box.volume();
-    let eta = density * std::f64::consts::PI * 0.25 * reach * reach;
+    let (eta, from) = match D {
+        2 => (density * PI * 0.25 * reach * reach, LISTS_FROM),
+        _ => (density * PI / 6.0 * reach * reach * reach, LISTS_FROM_3D),
+    };
     let wanted = match choice {
-        Neighbourhood::Auto => eta >= LISTS_FROM,
+        Neighbourhood::Auto => eta >= from,
         Neighbourhood::Grid => false,
         Neighbourhood::Lists => true,
     };
-    if D != 2 || !allow || !wanted {
+    if !(D == 2 || D == 3) || !allow || !wanted {
         return None;
     }
-    let range = (RANGE_HOLDS / (std::f64::consts::PI * density)).sqrt();
+    let range = match D {
+        2 => (RANGE_HOLDS / (PI * density)).sqrt(),
+        _ => (RANGE_HOLDS_3D / (4.0 / 3.0 * PI * density)).cbrt(),
+    };
     let mut skin = (range - reach).clamp(0.25 * reach, reach);
     for a in 0..D {
         if sim_box.boundary[a] == Boundary::Periodic {

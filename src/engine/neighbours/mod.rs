@@ -20,13 +20,14 @@
 //! computed as the exact negative from either side (`cⱼ − cᵢ = −(cᵢ − cⱼ)` in floating
 //! point, and the image count is `round(d/L)`, odd in `d`), so both sides agree.
 //!
-//! A list holds at most [`CAPACITY`](lists::CAPACITY) neighbours in one 32-byte block (a contiguous row, read
-//! by the batch kernel eight lanes at a time). A particle with more is *crowded*: it keeps
+//! A list holds at most [`CAPACITY`](lists::CAPACITY) neighbours a row in 32-byte blocks (contiguous
+//! rows, read by the batch kernel eight lanes at a time): one row for a disk, two for a
+//! sphere ([`rows_for`](lists::rows_for)). A particle with more is *crowded*: it keeps
 //! no list and searches the cell grid around its centre instead, which holds everyone in
 //! range (cells are `R` wide); it gets a list again at its next rebuild if the neighbours
-//! then fit. With short periodic axes (several images of one pair in range), in 3D, and for
-//! [`Neighbourhood::Auto`] below [`LISTS_FROM`], no lists are kept and the grid follows
-//! the particles.
+//! then fit. With short periodic axes (several images of one pair in range), and for
+//! [`Neighbourhood::Auto`] below [`LISTS_FROM`] ([`LISTS_FROM_3D`] for spheres), no lists
+//! are kept and the grid follows the particles.
 //!
 //! With lists, the cell grid ([`Cells`]) holds each particle by its centre, so a particle
 //! changes cell only when it rebuilds, with no crossing events.
@@ -38,8 +39,8 @@ use crate::engine::arrays::Store;
 use crate::engine::geometry::{Boundary, Particle, SimBox};
 use crate::engine::motion;
 use cells::{Cells, Coord};
-pub use lists::{LISTS_FROM, RANGE_HOLDS};
-use lists::{List, NONE, skin_for};
+pub use lists::{LISTS_FROM, LISTS_FROM_3D, RANGE_HOLDS, RANGE_HOLDS_3D};
+use lists::{List, NONE, Rows, skin_for};
 use nalgebra::SVector;
 use serde::{Deserialize, Serialize};
 
@@ -53,7 +54,7 @@ pub enum Neighbourhood {
     /// A grid of cells one contact distance wide following the particles (an event at each
     /// cell boundary).
     Grid,
-    /// Neighbour lists with a skin, where they can be kept (2D, no short periodic axis);
+    /// Neighbour lists with a skin, where they can be kept (no short periodic axis);
     /// elsewhere the grid.
     Lists,
 }
@@ -109,7 +110,7 @@ pub struct Neighbours<const D: usize> {
     listed: bool,
     /// Lists: one per particle (else empty).
     centres: Vec<SVector<f64, D>>,
-    /// Lists: one per particle (else empty).
+    /// Lists: `ROWS` rows per particle, particle `i`'s at `i·ROWS` (else empty).
     lists: Vec<List>,
     /// `R²`, the list range squared.
     range2: f64,
@@ -136,6 +137,27 @@ pub enum Saved<const D: usize> {
 }
 
 impl<const D: usize> Neighbours<D> {
+    /// Rows of a particle's list.
+    const ROWS: usize = lists::rows_for(D);
+
+    /// Particle `i`'s rows.
+    #[inline(always)]
+    fn rows(&self, i: usize) -> &[List] {
+        &self.lists[i * Self::ROWS..(i + 1) * Self::ROWS]
+    }
+
+    /// Particle `i`'s rows, to change.
+    #[inline(always)]
+    fn rows_mut(&mut self, i: usize) -> &mut [List] {
+        &mut self.lists[i * Self::ROWS..(i + 1) * Self::ROWS]
+    }
+
+    /// Whether particle `i` (with lists) is crowded.
+    #[inline]
+    fn is_crowded(&self, i: usize) -> bool {
+        lists::crowded(self.rows(i))
+    }
+
     /// Lists (centred where the particles are at `time`) or a grid following the particles,
     /// as `skin_for` decides; `allow_lists` is false with short periodic axes. The large
     /// arrays are built in `store`.
@@ -229,12 +251,17 @@ impl<const D: usize> Neighbours<D> {
         neighbours.range2 = range * range;
         neighbours.exit2 = half * half;
         neighbours.bound2 = 0.25 * skin * skin;
-        neighbours.lists = store.collect((0..n).map(|i| {
-            neighbours.scan(i);
-            List::from_members(&neighbours.scratch)
+        let rows = Self::ROWS;
+        let mut list = [List::EMPTY; 2];
+        neighbours.lists = store.collect((0..n * rows).map(|k| {
+            if k % rows == 0 {
+                neighbours.scan(k / rows);
+                lists::fill(&mut list[..rows], &neighbours.scratch);
+            }
+            list[k % rows]
         }));
         for &k in crowded {
-            neighbours.lists[k as usize] = List::CROWDED;
+            lists::set_crowded(neighbours.rows_mut(k as usize));
         }
         neighbours
     }
@@ -244,7 +271,7 @@ impl<const D: usize> Neighbours<D> {
         match self.listed() {
             true => Saved::Centres(
                 self.centres.clone(),
-                (0..self.lists.len() as u32).filter(|&k| self.lists[k as usize].crowded()).collect(),
+                (0..self.centres.len() as u32).filter(|&k| self.is_crowded(k as usize)).collect(),
             ),
             false => Saved::Cells(self.cells.coords().to_vec()),
         }
@@ -337,16 +364,19 @@ impl<const D: usize> Neighbours<D> {
         }
         // Leave every old neighbour's list (a crowded particle does not know them: everyone
         // in the cells around is asked, and `drop` ignores those without it).
-        let list = self.lists[i];
-        if list.crowded() {
-            for j in self.cells.neighbours(self.cell(i)) {
+        let mut old = [List::EMPTY; 2];
+        old[..Self::ROWS].copy_from_slice(self.rows(i));
+        let old = Rows(&old[..Self::ROWS]);
+        if old.crowded() {
+            let (cell, rows) = (self.cell(i), Self::ROWS);
+            for j in self.cells.neighbours(cell) {
                 if j != i {
-                    self.lists[j].drop(i as u32);
+                    lists::drop(&mut self.lists[j * rows..(j + 1) * rows], i as u32);
                 }
             }
         } else {
-            for j in list.members() {
-                self.lists[j].drop(i as u32);
+            for j in old.members() {
+                lists::drop(self.rows_mut(j), i as u32);
             }
         }
         let centre = p.position_at(t);
@@ -357,10 +387,12 @@ impl<const D: usize> Neighbours<D> {
         }
         self.centres[i] = centre;
         self.scan(i);
-        for &j in &self.scratch {
-            self.lists[j as usize].add(i as u32);
+        let found = std::mem::take(&mut self.scratch);
+        for &j in &found {
+            lists::add(self.rows_mut(j as usize), i as u32);
         }
-        self.lists[i] = List::from_members(&self.scratch);
+        lists::fill(self.rows_mut(i), &found);
+        self.scratch = found;
     }
 
     /// When particle `p` (number `i`) next has to [`rebuild`](Self::rebuild), as an absolute
@@ -435,11 +467,11 @@ impl<const D: usize> Neighbours<D> {
     /// its centre (`None` if they do not fit).
     #[inline]
     pub fn gather(&self, i: usize, skip: usize, out: &mut [u32]) -> Option<usize> {
-        let Some(list) = self.lists.get(i).filter(|list| !list.crowded()) else {
+        let Some(list) = self.row(i).filter(|list| !list.crowded()) else {
             return self.cells.gather(&self.cell(i), i, skip, out);
         };
         let mut len = 0;
-        for (k, &j) in list.entries().iter().enumerate() {
+        for (k, j) in list.entries().enumerate() {
             out[len.min(k)] = j;
             len += ((j != NONE) & (j as usize != skip)) as usize;
         }
@@ -450,8 +482,8 @@ impl<const D: usize> Neighbours<D> {
     /// without lists) everyone in the cells around it, `i` included — the same set the
     /// batch search sees through [`gather`](Self::gather).
     pub fn candidates(&self, i: usize) -> impl Iterator<Item = usize> + '_ {
-        let list = self.lists.get(i).filter(|list| !list.crowded());
-        let listed = list.into_iter().flat_map(List::members);
+        let list = self.row(i).filter(|list| !list.crowded());
+        let listed = list.into_iter().flat_map(|list| list.members());
         let grid = list.is_none().then(|| self.cells.neighbours(self.cell(i))).into_iter().flatten();
         listed.chain(grid)
     }
@@ -462,10 +494,10 @@ impl<const D: usize> Neighbours<D> {
         &self.cells
     }
 
-    /// Particle `i`'s list row, with lists.
+    /// Particle `i`'s list rows, with lists.
     #[inline]
-    pub(crate) fn row(&self, i: usize) -> Option<&List> {
-        self.lists.get(i)
+    pub(crate) fn row(&self, i: usize) -> Option<Rows<'_>> {
+        self.listed.then(|| Rows(self.rows(i)))
     }
 
     /// The list centres (empty without lists).
@@ -478,11 +510,11 @@ impl<const D: usize> Neighbours<D> {
     /// centres are within range (for the particles that are not crowded); for tests.
     #[cfg(test)]
     pub fn check(&self) {
-        for i in 0..self.lists.len() {
-            if self.lists[i].crowded() {
+        for i in 0..self.centres.len() {
+            if self.is_crowded(i) {
                 continue;
             }
-            let mut listed: Vec<u32> = self.lists[i].members().map(|j| j as u32).collect();
+            let mut listed: Vec<u32> = Rows(self.rows(i)).members().map(|j| j as u32).collect();
             listed.sort_unstable();
             let mut expected: Vec<u32> =
                 (0..self.centres.len()).filter(|&j| j != i && self.within(i, j)).map(|j| j as u32).collect();
@@ -493,7 +525,7 @@ impl<const D: usize> Neighbours<D> {
 
     /// How many particles are crowded (for tests and the benchmark's notes).
     pub fn crowded(&self) -> usize {
-        self.lists.iter().filter(|list| list.crowded()).count()
+        (0..self.centres.len()).filter(|&i| self.is_crowded(i)).count()
     }
 }
 

@@ -55,7 +55,9 @@ fn starts_at(l2: Option<usize>) -> usize {
 fn row<const D: usize>(at: &Reading<'_, D>, i: usize) {
     match at.neighbours.row(i) {
         Some(row) => {
-            prefetch(row);
+            for block in row.blocks() {
+                prefetch(block);
+            }
             prefetch(&at.neighbours.centres()[i]);
         }
         None => {
@@ -120,7 +122,7 @@ pub(super) fn second_stage<const D: usize>(at: &Reading<'_, D>, next: usize) -> 
             if let Some(row) = at.neighbours.row(next) {
                 // The rows it leaves, and the cells around where its new centre will be.
                 for j in row.members() {
-                    prefetch(at.neighbours.row(j).expect("lists"));
+                    prefetch(&at.neighbours.row(j).expect("lists").blocks()[0]);
                 }
                 let cells = at.neighbours.cells();
                 let centre = at.particles[next].position_at(event.time);
