@@ -29,6 +29,12 @@ pub(crate) struct List([u32; CAPACITY]);
 
 impl List {
     pub(crate) const EMPTY: List = List([NONE; CAPACITY]);
+
+    /// The row's entries.
+    #[inline(always)]
+    pub(crate) fn entries(&self) -> &[u32; CAPACITY] {
+        &self.0
+    }
 }
 
 /// One particle's list, its rows: its neighbours, `NONE` after the last; `CROWDED` first for
@@ -57,6 +63,23 @@ impl<'a> Rows<'a> {
         self.entries().skip(skip).take_while(|&j| j != NONE).map(|j| j as usize)
     }
 
+    /// Calls `f` with each member, in order (none when crowded): the loops of
+    /// [`members`](Self::members) written out, for the prefetches of the timing room.
+    #[inline(always)]
+    pub(crate) fn for_each_member(self, mut f: impl FnMut(usize)) {
+        if self.crowded() {
+            return;
+        }
+        for row in self.0 {
+            for &j in &row.0 {
+                if j == NONE {
+                    return;
+                }
+                f(j as usize);
+            }
+        }
+    }
+
     /// The rows, for prefetching.
     #[inline]
     pub(crate) fn blocks(self) -> &'a [List] {
@@ -71,12 +94,13 @@ fn at(rows: &mut [List], k: usize) -> &mut u32 {
 }
 
 /// Whether `rows` are crowded.
-#[inline]
+#[inline(always)]
 pub(crate) fn crowded(rows: &[List]) -> bool {
     rows[0].0[0] == CROWDED
 }
 
 /// Takes `i` out of `rows`, moving the last entry into its place (no-op if crowded or absent).
+#[inline]
 pub(crate) fn drop(rows: &mut [List], i: u32) {
     if crowded(rows) {
         return;
@@ -95,6 +119,7 @@ pub(crate) fn drop(rows: &mut [List], i: u32) {
 }
 
 /// Puts `i` into `rows`; full rows become crowded.
+#[inline]
 pub(crate) fn add(rows: &mut [List], i: u32) {
     if crowded(rows) {
         return;
@@ -108,6 +133,7 @@ pub(crate) fn add(rows: &mut [List], i: u32) {
 }
 
 /// Rows holding `members`, or crowded ones if they do not fit.
+#[inline]
 pub(crate) fn fill(rows: &mut [List], members: &[u32]) {
     if members.len() > rows.len() * CAPACITY {
         set_crowded(rows);

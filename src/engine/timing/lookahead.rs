@@ -96,11 +96,7 @@ fn neighbourhood<const D: usize>(at: &Reading<'_, D>, i: usize) {
                 prefetch(cells.head(c));
             }
         }
-        Some(row) => {
-            for j in row.members() {
-                prefetch(&at.particles[j]);
-            }
-        }
+        Some(row) => row.for_each_member(|j| prefetch(&at.particles[j])),
     }
 }
 
@@ -121,9 +117,7 @@ pub(super) fn second_stage<const D: usize>(at: &Reading<'_, D>, next: usize) -> 
         EventKind::Rebuild => {
             if let Some(row) = at.neighbours.row(next) {
                 // The rows it leaves, and the cells around where its new centre will be.
-                for j in row.members() {
-                    prefetch(&at.neighbours.row(j).expect("lists").blocks()[0]);
-                }
+                row.for_each_member(|j| prefetch(&at.neighbours.row(j).expect("lists").blocks()[0]));
                 let cells = at.neighbours.cells();
                 let centre = at.particles[next].position_at(event.time);
                 let around = cells.around(&cells.locate(&centre));
