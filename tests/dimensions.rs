@@ -193,3 +193,44 @@ fn trajectory_frames_carry_z_in_three_dimensions() {
     assert!(zs.iter().all(|&z| (0.0..l[2]).contains(&z)), "{zs:?}");
     assert!(zs.iter().any(|&z| z != zs[0]), "z varies");
 }
+
+/// Every engine tunable leaves the collisions of spheres unchanged to the bit, as of disks:
+/// both neighbourhoods, both queues, with and without the lookahead (forced on at this small
+/// N, so that its prefetches walk the two rows of a sphere's list) — a dense fluid from a
+/// simple cubic start, where lists are kept and some spheres are crowded.
+#[test]
+fn engine_tunables_change_no_collision_of_spheres() {
+    use collide::engine::{EngineParams, Outcome, QueueChoice, Switch};
+    let species = vec![Species { count: 343, radius: 0.5, mass: 1.0 }];
+    let sim_box = box_for_packing_fraction::<3>(&species, 0.45, [Boundary::Periodic; 3], Placement::SimpleCubic, None);
+    let particles =
+        initial_particles(&species, &sim_box, Placement::SimpleCubic, Velocities::Maxwell, 1.0, 12).unwrap();
+    let collisions = |params: EngineParams| {
+        let mut sim = Simulation::with_params(particles.clone(), sim_box, params).unwrap();
+        let mut out = Vec::new();
+        while out.len() < 20_000 {
+            if let Outcome::Pair { i, j, .. } = sim.step().expect("an event") {
+                out.push((sim.time().to_bits(), i, j));
+            }
+        }
+        (out, sim.particles().to_vec(), sim.lists())
+    };
+    // The lattice's 6 + 12 nearest sites lie within range: every sphere starts crowded.
+    let start = Simulation::with_neighbourhood(particles.clone(), sim_box, Neighbourhood::Lists).unwrap();
+    assert!(start.crowded() > 0, "no crowded sphere");
+    let (expected, state, _) = collisions(EngineParams::with_neighbourhood(Neighbourhood::Grid));
+    let mut listed = 0;
+    for neighbourhood in [Neighbourhood::Grid, Neighbourhood::Lists] {
+        for queue in [QueueChoice::Calendar, QueueChoice::Tree] {
+            for lookahead in [Switch::On, Switch::Off] {
+                let mut params = EngineParams::with_neighbourhood(neighbourhood);
+                (params.queue, params.lookahead) = (queue, lookahead);
+                let (got, final_state, lists) = collisions(params);
+                assert!(got == expected, "{params:?}: the collisions differ");
+                assert!(final_state == state, "{params:?}: the final state differs");
+                listed += lists as usize;
+            }
+        }
+    }
+    assert_eq!(listed, 4);
+}

@@ -10,10 +10,14 @@ use crate::engine::geometry::{Boundary, SimBox};
 pub const CAPACITY: usize = 8;
 
 /// Rows a particle's list spans: one in 2D, two in 3D (a dense sphere fluid has about twice
-/// the neighbours in range of a disk fluid).
+/// the neighbours in range of a disk fluid; three rows, with a range holding 14 to 18, were
+/// slower at η = 0.45: `benches/HISTORY.md`).
 pub const fn rows_for(dimension: usize) -> usize {
     if dimension >= 3 { 2 } else { 1 }
 }
+
+/// The most rows any dimension's lists span.
+pub(crate) const MAX_ROWS: usize = rows_for(3);
 
 /// An unused entry (lists are packed at the front).
 pub(crate) const NONE: u32 = u32::MAX;

@@ -252,7 +252,7 @@ impl<const D: usize> Neighbours<D> {
         neighbours.exit2 = half * half;
         neighbours.bound2 = 0.25 * skin * skin;
         let rows = Self::ROWS;
-        let mut list = [List::EMPTY; 2];
+        let mut list = [List::EMPTY; lists::MAX_ROWS];
         neighbours.lists = store.collect((0..n * rows).map(|k| {
             if k % rows == 0 {
                 neighbours.scan(k / rows);
@@ -364,7 +364,7 @@ impl<const D: usize> Neighbours<D> {
         }
         // Leave every old neighbour's list (a crowded particle does not know them: everyone
         // in the cells around is asked, and `drop` ignores those without it).
-        let mut old = [List::EMPTY; 2];
+        let mut old = [List::EMPTY; lists::MAX_ROWS];
         old[..Self::ROWS].copy_from_slice(self.rows(i));
         let old = Rows(&old[..Self::ROWS]);
         if old.crowded() {
