@@ -16,6 +16,7 @@
 //! a queue of 10⁴ by a later one, with either structure (per update, as after every
 //! collision; in the tree the root owner's is the longest walk).
 
+use collide::bench::floor::Floor;
 use collide::engine::init::{Placement, Species, Velocities, box_for_packing_fraction, initial_particles};
 use collide::engine::internals::{
     EventQueue, LANES, Lanes, PairBracket, QueueKind, bracket_neighbours, bracket_pair, pair_positions,
@@ -86,6 +87,18 @@ fn engine(c: &mut Criterion) {
 
 /// The hardware's floor (`collide::bench::floor`) at η = 0.65: per collision, for the
 /// engine's rate as a fraction of it.
+/// `iters` steps of the floor, timed.
+fn floor_steps<const D: usize>(
+    floor: &mut Floor<D>,
+    rng: &mut Xoshiro256PlusPlus,
+    iters: u64,
+    lookahead: bool,
+) -> Duration {
+    let start = Instant::now();
+    floor.run(rng, iters, lookahead);
+    start.elapsed()
+}
+
 fn floor(c: &mut Criterion) {
     let mut group = c.benchmark_group("engine/floor");
     group.throughput(Throughput::Elements(1));
@@ -93,22 +106,14 @@ fn floor(c: &mut Criterion) {
         // Both loops, as `collide bench` times them (it reports the faster).
         for lookahead in [false, true] {
             let loop_name = if lookahead { "lookahead" } else { "plain" };
-            let mut disks = collide::bench::floor::Floor::<2>::new(n, 0.65, 1).unwrap();
             let mut rng = Xoshiro256PlusPlus::seed_from_u64(2);
+            let mut disks = Floor::<2>::new(n, 0.65, 1).unwrap();
             group.bench_function(BenchmarkId::new(format!("eta=0.65/{loop_name}"), n), |b| {
-                b.iter_custom(|iters| {
-                    let start = Instant::now();
-                    disks.run(&mut rng, iters, lookahead);
-                    start.elapsed()
-                })
+                b.iter_custom(|iters| floor_steps(&mut disks, &mut rng, iters, lookahead))
             });
-            let mut spheres = collide::bench::floor::Floor::<3>::new(n, 0.45, 1).unwrap();
+            let mut spheres = Floor::<3>::new(n, 0.45, 1).unwrap();
             group.bench_function(BenchmarkId::new(format!("3d/eta=0.45/{loop_name}"), n), |b| {
-                b.iter_custom(|iters| {
-                    let start = Instant::now();
-                    spheres.run(&mut rng, iters, lookahead);
-                    start.elapsed()
-                })
+                b.iter_custom(|iters| floor_steps(&mut spheres, &mut rng, iters, lookahead))
             });
         }
     }

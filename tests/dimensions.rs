@@ -56,14 +56,19 @@ fn a_run_of_spheres_conserves_and_resumes_bit_identically() {
     assert!(whole.wall_pressures.iter().all(|w| w.pressure > 0.0));
     assert!(whole.samples > 20 && whole.compressibility > 1.0);
 
-    // The same run, checkpointed at the end of equilibration and resumed from the JSON text.
+    resumes_to(config, &whole, run.sim.particles());
+}
+
+/// The run of `config`, checkpointed at the end of equilibration and resumed from the JSON
+/// text, ends with the summary `whole` and the particles `end` of the run never interrupted.
+fn resumes_to(config: Config, whole: &Summary, end: &[collide::engine::Particle<3>]) {
     let mut first = Run::<3>::new(config).unwrap();
     let Ok(_) = first.equilibrate(&mut Discard);
     let text = first.checkpoint(0).to_json();
     let mut resumed = Run::resume(Checkpoint::<3>::from_json(text.as_bytes()).unwrap()).unwrap();
     let Ok(_) = resumed.complete(&mut Discard);
-    assert_eq!(reproducible(resumed.summary()), whole);
-    assert_eq!(resumed.sim.particles(), run.sim.particles());
+    assert_eq!(&reproducible(resumed.summary()), whole);
+    assert_eq!(resumed.sim.particles(), end);
 }
 
 /// The fast engine and the O(N²) reference give the same collisions, to the bit, for spheres
@@ -131,13 +136,7 @@ fn spheres_with_lists_resume_bit_identically() {
     let Ok(_) = run.complete(&mut Discard);
     let whole = reproducible(run.summary());
     assert!(whole.max_overlap.fraction <= 1e-12, "{:?}", whole.max_overlap);
-    let mut first = Run::<3>::new(config).unwrap();
-    let Ok(_) = first.equilibrate(&mut Discard);
-    let text = first.checkpoint(0).to_json();
-    let mut resumed = Run::resume(Checkpoint::<3>::from_json(text.as_bytes()).unwrap()).unwrap();
-    let Ok(_) = resumed.complete(&mut Discard);
-    assert_eq!(reproducible(resumed.summary()), whole);
-    assert_eq!(resumed.sim.particles(), run.sim.particles());
+    resumes_to(config, &whole, run.sim.particles());
 }
 
 /// Initial states in 3D: random placement without overlap, one speed per species with

@@ -62,8 +62,8 @@ pub struct BenchPoint {
     pub huge_page_bytes: Option<u64>,
     /// The hardware's floor for the same N and η on this machine ([`floor`]: move two
     /// particles, bounce, re-predict both against fixed neighbours — eight disks or sixteen
-    /// spheres; no queue, no list upkeep, no exact times), collisions per second — measured in the same process after
-    /// the engine, with as many timed collisions.
+    /// spheres; no queue, no list upkeep, no exact times), collisions per second — measured
+    /// in the same process after the engine, with as many timed collisions.
     #[serde(default)]
     pub floor_collisions_per_second: Option<f64>,
     /// Whether the floor's faster loop was the one that prefetches (`bench::floor::Floor::run`).

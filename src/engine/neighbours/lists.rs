@@ -51,7 +51,7 @@ impl<'a> Rows<'a> {
     /// the grid of centres instead).
     #[inline]
     pub(crate) fn crowded(&self) -> bool {
-        self.0[0].0[0] == CROWDED
+        crowded(self.0)
     }
 
     /// The entries, members first (`NONE` after the last; `CROWDED` first when crowded).
