@@ -4,6 +4,8 @@
 //!   (η = 0.65, jittered triangular lattice, Maxwell velocities) — what an event-driven code
 //!   predicts all day. Mix: about half receding, the rest hits or misses.
 //! * `contact/hard`: near-contact gaps of a few ulps, grazing at 10⁶σ, neighbours at 10⁹.
+//! * `contact/growing`: the realistic pairs with every radius growing at 0.1 of itself per
+//!   unit time (what a compression predicts).
 //! * `roots/realistic` and `roots/hard`: random moderate coefficients; near-double roots and
 //!   extreme scales.
 //! * `contact/pin`: the contacts among the realistic pairs; `narrow` is
@@ -22,8 +24,8 @@
 
 use criterion::{Criterion, Throughput, criterion_group, criterion_main};
 use quadratic::{
-    Ball, BallLanes, Bracket, contact_bracket, contact_brackets, contact_time, contact_time_exact_path, narrow_contact,
-    solve, textbook,
+    Ball, BallLanes, Bracket, contact_bracket, contact_brackets, contact_time, contact_time_exact_path,
+    contact_time_growing, contact_time_growing_exact_path, narrow_contact, solve, textbook,
 };
 use rand::rngs::Xoshiro256PlusPlus;
 use rand::{RngExt, SeedableRng};
@@ -200,6 +202,47 @@ fn contact(c: &mut Criterion) {
     group.finish();
 }
 
+/// `contact/growing`: the realistic pairs again, every radius growing at `rate` of itself per
+/// unit time (a compression's neighbours), through `quadratic::contact_time_growing` (its
+/// filter), its exact path alone, and the textbook growing formula.
+fn growing(c: &mut Criterion) {
+    let realistic = dense_fluid_pairs(0.65, 40, 1);
+    let mut group = c.benchmark_group("contact/growing");
+    group.throughput(Throughput::Elements(realistic.len() as u64));
+    let rates = |p: &Ball<2>, q: &Ball<2>| [0.1 * p.radius, 0.1 * q.radius];
+    group.bench_function("robust", |b| {
+        b.iter(|| {
+            let mut n = 0.0;
+            for (p, q) in realistic.iter() {
+                let g = rates(p, q);
+                n += contact_time_growing(black_box(p), black_box(q), g).unwrap().time().unwrap_or(-1.0);
+            }
+            n
+        })
+    });
+    group.bench_function("exact-path", |b| {
+        b.iter(|| {
+            let mut n = 0.0;
+            for (p, q) in realistic.iter() {
+                let g = rates(p, q);
+                n += contact_time_growing_exact_path(black_box(p), black_box(q), g).time().unwrap_or(-1.0);
+            }
+            n
+        })
+    });
+    group.bench_function("textbook", |b| {
+        b.iter(|| {
+            let mut n = 0.0;
+            for (p, q) in realistic.iter() {
+                let g = rates(p, q);
+                n += textbook::contact_time_growing(black_box(p), black_box(q), g).time().unwrap_or(-1.0);
+            }
+            n
+        })
+    });
+    group.finish();
+}
+
 fn roots(c: &mut Criterion) {
     let mut rng = Xoshiro256PlusPlus::seed_from_u64(3);
     let realistic: Vec<(f64, f64, f64)> = (0..3000)
@@ -234,5 +277,5 @@ fn config() -> Criterion {
     Criterion::default().warm_up_time(Duration::from_secs(1)).measurement_time(Duration::from_secs(3)).sample_size(40)
 }
 
-criterion_group! { name = benches; config = config(); targets = contact, roots }
+criterion_group! { name = benches; config = config(); targets = contact, growing, roots }
 criterion_main!(benches);

@@ -82,7 +82,8 @@ enum Command {
     Check,
     /// Real roots of a·x² + b·x + c = 0: prints them ascending on one line, "none", or "all".
     Roots(RootsArgs),
-    /// Earliest contact time of two disks (or spheres): prints the time, or "never".
+    /// Earliest contact time of two disks (or spheres), optionally with growing radii: prints
+    /// the time, or "never".
     ContactTime(ContactArgs),
     /// Runs one physics experiment and writes DIR/NAME/result.json and its plots; exits 1
     /// if a check fails. `collide validate` runs them all.
@@ -209,6 +210,12 @@ struct ContactArgs {
     /// Radius of disk 2.
     #[arg(long = "R2", allow_hyphen_values = true)]
     radius2: Option<String>,
+    /// Growth rate of radius 1 (the radius is R1 + g1·t; default 0, must be ≥ 0).
+    #[arg(long, allow_hyphen_values = true)]
+    g1: Option<String>,
+    /// Growth rate of radius 2.
+    #[arg(long, allow_hyphen_values = true)]
+    g2: Option<String>,
 }
 
 fn main() -> ExitCode {
@@ -353,10 +360,10 @@ fn roots(args: RootsArgs) -> Result<ExitCode> {
 
 fn contact(args: ContactArgs) -> Result<ExitCode> {
     let format = args.output.format();
-    let given = [&args.r1, &args.v1, &args.radius1, &args.r2, &args.v2, &args.radius2];
+    let given = [&args.r1, &args.v1, &args.radius1, &args.r2, &args.v2, &args.radius2, &args.g1, &args.g2];
     if args.output.jsonl {
         if given.iter().any(|x| x.is_some()) {
-            bail!("give either --jsonl or the options --r1 --v1 --R1 --r2 --v2 --R2, not both");
+            bail!("give either --jsonl or the options --r1 --v1 --R1 --r2 --v2 --R2 (--g1 --g2), not both");
         }
         return jsonl(Query::ContactTime, format);
     }
@@ -385,7 +392,10 @@ fn contact(args: ContactArgs) -> Result<ExitCode> {
         velocity: vector(&args.v2, "v2")?,
         radius: scalar(&args.radius2, "R2")?,
     };
-    let t = contact_time_dyn(&first, &second)?;
+    let rate = |value: &Option<String>, name: &str| -> Result<f64> {
+        value.as_deref().map_or(Ok(0.0), |s| parse_text(s).with_context(|| format!("--{name}")))
+    };
+    let t = contact_time_dyn(&first, &second, [rate(&args.g1, "g1")?, rate(&args.g2, "g2")?])?;
     say!("{}", t.map_or_else(|| "never".to_string(), |t| format_text(t, format)));
     Ok(ExitCode::SUCCESS)
 }

@@ -64,6 +64,53 @@ fn contact_time_prints_time_or_never() {
     assert!(text(&missing.stderr).contains("missing --v1"), "{}", text(&missing.stderr));
 }
 
+/// Growing radii: `--g1`/`--g2` on the one-shot form, `"g1"`/`"g2"` in JSON lines; every
+/// growing case of the edge-case reference answered by the CLI exactly as stored (hex out).
+#[test]
+fn contact_time_takes_growth_rates() {
+    let grow =
+        ["contact-time", "--r1", "0,0", "--v1", "0,0", "--R1", "0.5", "--r2", "3,0", "--v2", "0,0", "--R2", "0.5"];
+    assert_eq!(text(&collide(&grow, "").stdout), "never\n");
+    let with = [&grow[..], &["--g1", "0.5", "--g2", "0x1p-1"]].concat();
+    assert_eq!(text(&collide(&with, "").stdout), "2.0\n");
+    let bad = [&grow[..], &["--g1=-0.5"]].concat();
+    let out = collide(&bad, "");
+    assert_eq!(out.status.code(), Some(2));
+    assert!(text(&out.stderr).contains("g1 = -0.5 is negative; a growth rate must be ≥ 0"), "{}", text(&out.stderr));
+    let out = collide(&[&grow[..], &["--g2", "fast"]].concat(), "");
+    assert_eq!(out.status.code(), Some(2));
+    assert!(text(&out.stderr).contains("--g2"), "{}", text(&out.stderr));
+
+    use quadratic::reference::{GROWING_CASES, describe_contact};
+    let hex = quadratic::hex::format;
+    let vector = |v: [f64; 2]| format!("[\"{}\", \"{}\"]", hex(v[0]), hex(v[1]));
+    let mut input = String::new();
+    for (k, c) in GROWING_CASES.iter().enumerate() {
+        input += &format!(
+            "{{\"id\": {k}, \"r1\": {}, \"v1\": {}, \"R1\": \"{}\", \"r2\": {}, \"v2\": {}, \"R2\": \"{}\", \"g1\": \"{}\", \"g2\": \"{}\"}}\n",
+            vector(c.first.position),
+            vector(c.first.velocity),
+            hex(c.first.radius),
+            vector(c.second.position),
+            vector(c.second.velocity),
+            hex(c.second.radius),
+            hex(c.rates[0]),
+            hex(c.rates[1]),
+        );
+    }
+    let out = collide(&["contact-time", "--jsonl", "--hex"], &input);
+    assert!(out.status.success(), "{}", text(&out.stderr));
+    let lines: Vec<String> = text(&out.stdout).lines().map(String::from).collect();
+    assert_eq!(lines.len(), GROWING_CASES.len());
+    for (line, c) in lines.iter().zip(GROWING_CASES) {
+        let want = match c.exact.time() {
+            None => "null".to_string(),
+            Some(t) => format!("\"{}\"", hex(t)),
+        };
+        assert!(line.ends_with(&format!("\"t\":{want}}}")), "{}: {line} for {}", c.name, describe_contact(&c.exact));
+    }
+}
+
 #[test]
 fn jsonl_answers_every_good_line_and_fails_at_the_end_for_bad_ones() {
     let input = "{\"id\": \"a\", \"a\": 1, \"b\": -3, \"c\": 2}\n{\"id\": 2, \"a\": 1\n{\"id\": 3, \"a\": \"0x1p-1074\", \"b\": 0, \"c\": \"-0x1p-1074\"}\n";

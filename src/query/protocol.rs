@@ -4,8 +4,11 @@
 //!   `{"id": <same>, "roots": [x1, x2]}` (ascending; `[]` for none; one element for one root)
 //!   or `{"id": <same>, "all": true}` when every x solves `0 = 0`.
 //! * `contact-time`: `{"id": <any>, "r1": [x, y], "v1": [..], "R1": <num>, "r2": [..],
-//!   "v2": [..], "R2": <num>}` (2 or 3 components, the same for all four vectors) →
-//!   `{"id": <same>, "t": <num or null>}` (`null` = never, `0` = now).
+//!   "v2": [..], "R2": <num>}` (2 or 3 components, the same for all four vectors), and
+//!   optionally `"g1"`, `"g2"`: the growth rates of `R1` and `R2` (radius `R + g·t`, default
+//!   0, each ≥ 0) → `{"id": <same>, "t": <num or null>}` (`null` = never, `0` = now).
+//!   With growth the answer is [`quadratic::contact_time_growing`]'s; without, it is
+//!   [`quadratic::contact_time`]'s, bit for bit.
 //!
 //! `<num>` is a JSON number or a string holding a decimal or hex float, read exactly
 //! ([`super::numbers`]). An output number beyond the f64 range (a root or a time that
@@ -13,7 +16,8 @@
 //! out is strict JSON. `id` is echoed verbatim, as its source text (`null` if absent).
 //!
 //! A line that cannot be answered — not UTF-8, longer than [`MAX_LINE`] bytes, malformed
-//! JSON, a duplicate, unknown or missing key, a non-finite number, a negative radius —
+//! JSON, a duplicate, unknown or missing key, a non-finite number, a negative radius or
+//! growth rate —
 //! produces no output line and one short message on the error stream naming its line
 //! number; every other line is still answered. Blank lines are skipped.
 
@@ -192,12 +196,14 @@ fn vector(fields: &Fields, key: &str) -> Result<Vec<f64>, String> {
 }
 
 fn answer_contact(fields: &Fields, format: NumberFormat) -> Result<String, String> {
-    check_keys(fields, &["id", "r1", "v1", "R1", "r2", "v2", "R2"])?;
+    check_keys(fields, &["id", "r1", "v1", "R1", "r2", "v2", "R2", "g1", "g2"])?;
     let first =
         DynBall { position: vector(fields, "r1")?, velocity: vector(fields, "v1")?, radius: number(fields, "R1")? };
     let second =
         DynBall { position: vector(fields, "r2")?, velocity: vector(fields, "v2")?, radius: number(fields, "R2")? };
-    let time = contact_time_dyn(&first, &second).map_err(|e| e.to_string())?;
+    let rate = |key: &str| if fields.raw(key).is_some() { number(fields, key) } else { Ok(0.0) };
+    let rates = [rate("g1")?, rate("g2")?];
+    let time = contact_time_dyn(&first, &second, rates).map_err(|e| e.to_string())?;
     let t = time.map_or_else(|| "null".to_string(), |t| format_json(t, format));
     Ok(format!("{{\"id\":{},\"t\":{t}}}", id_text(fields)))
 }
@@ -231,7 +237,8 @@ pub enum QueryError {
         /// `r1`'s components.
         found: usize,
     },
-    /// The kernel refused the balls (a negative or non-finite radius, a non-finite coordinate).
+    /// The kernel refused the balls (a negative or non-finite radius or growth rate, a
+    /// non-finite coordinate).
     Contact(quadratic::ContactError),
 }
 
@@ -251,9 +258,10 @@ impl std::fmt::Display for QueryError {
 
 impl std::error::Error for QueryError {}
 
-/// The contact time of two balls given at run time: 2 or 3 components, all the same length.
-/// `Ok(None)` is "never"; `Ok(Some(0.0))` is "now".
-pub fn contact_time_dyn(first: &DynBall, second: &DynBall) -> Result<Option<f64>, QueryError> {
+/// The contact time of two balls given at run time, 2 or 3 components, all the same length,
+/// whose radii grow at `rates` (`[0.0, 0.0]`: rigid balls, [`quadratic::contact_time`] bit for
+/// bit). `Ok(None)` is "never"; `Ok(Some(0.0))` is "now".
+pub fn contact_time_dyn(first: &DynBall, second: &DynBall, rates: [f64; 2]) -> Result<Option<f64>, QueryError> {
     let d = first.position.len();
     for (field, v) in [("v1", &first.velocity), ("r2", &second.position), ("v2", &second.velocity)] {
         if v.len() != d {
@@ -265,8 +273,8 @@ pub fn contact_time_dyn(first: &DynBall, second: &DynBall) -> Result<Option<f64>
         Ball { position: arr(&b.position), velocity: arr(&b.velocity), radius: b.radius }
     }
     let contact = match d {
-        2 => quadratic::contact_time(&fixed::<2>(first), &fixed::<2>(second)),
-        3 => quadratic::contact_time(&fixed::<3>(first), &fixed::<3>(second)),
+        2 => quadratic::contact_time_growing(&fixed::<2>(first), &fixed::<2>(second), rates),
+        3 => quadratic::contact_time_growing(&fixed::<3>(first), &fixed::<3>(second), rates),
         _ => return Err(QueryError::Dimension { found: d }),
     };
     contact.map(|c| c.time()).map_err(QueryError::Contact)
@@ -330,5 +338,25 @@ mod tests {
         assert_eq!(failed, 2);
         assert!(err.contains("line 4: R1 = -1 is negative"), "{err}");
         assert!(err.contains("line 5: v1 has 3 components but r1 has 2"), "{err}");
+    }
+
+    #[test]
+    fn growth_rates_are_optional_keys() {
+        let input = concat!(
+            // At rest 3 apart, σ = 1 + t: t = 2; the same without rates: never.
+            "{\"id\": 1, \"r1\": [0, 0], \"v1\": [0, 0], \"R1\": 0.5, \"r2\": [3, 0], \"v2\": [0, 0], \"R2\": 0.5, \"g1\": 0.5, \"g2\": \"0x1p-1\"}\n",
+            "{\"id\": 2, \"r1\": [0, 0], \"v1\": [0, 0], \"R1\": 0.5, \"r2\": [3, 0], \"v2\": [0, 0], \"R2\": 0.5}\n",
+            // Spheres, one growing: 2 − 1 = t at t = 1.
+            "{\"id\": 3, \"r1\": [0, 0, 0], \"v1\": [0, 0, 0], \"R1\": 0.5, \"r2\": [0, 0, 2], \"v2\": [0, 0, 0], \"R2\": 0.5, \"g2\": 1}\n",
+            "{\"id\": 4, \"r1\": [0, 0], \"v1\": [0, 0], \"R1\": 0.5, \"r2\": [3, 0], \"v2\": [0, 0], \"R2\": 0.5, \"g2\": -1}\n",
+            "{\"id\": 5, \"r1\": [0, 0], \"v1\": [0, 0], \"R1\": 0.5, \"r2\": [3, 0], \"v2\": [0, 0], \"R2\": 0.5, \"g1\": \"nan\"}\n",
+            "{\"id\": 6, \"r1\": [0, 0], \"v1\": [0, 0], \"R1\": 0.5, \"r2\": [3, 0], \"v2\": [0, 0], \"R2\": 0.5, \"g3\": 1}\n",
+        );
+        let (out, err, failed) = run(Query::ContactTime, input, NumberFormat::Shortest);
+        assert_eq!(out, "{\"id\":1,\"t\":2.0}\n{\"id\":2,\"t\":null}\n{\"id\":3,\"t\":1.0}\n");
+        assert_eq!(failed, 3);
+        assert!(err.contains("line 4: g2 = -1 is negative; a growth rate must be ≥ 0"), "{err}");
+        assert!(err.contains("line 5: g1: "), "{err}");
+        assert!(err.contains("line 6: unknown key 'g3' (allowed: id, r1, v1, R1, r2, v2, R2, g1, g2)"), "{err}");
     }
 }

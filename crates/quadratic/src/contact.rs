@@ -104,6 +104,8 @@ pub enum Field {
     Velocity(usize),
     /// The radius.
     Radius,
+    /// The growth rate of the radius ([`contact_time_growing`](crate::contact_time_growing)).
+    Growth,
 }
 
 /// Why [`contact_time`] refused its input.
@@ -126,6 +128,14 @@ pub enum ContactError {
         /// The value.
         value: f64,
     },
+    /// A negative growth rate ([`contact_time_growing`](crate::contact_time_growing)): radii
+    /// may grow or stay, not shrink.
+    NegativeGrowth {
+        /// 1 or 2: which ball.
+        ball: u8,
+        /// The value.
+        value: f64,
+    },
 }
 
 impl fmt::Display for ContactError {
@@ -134,6 +144,7 @@ impl fmt::Display for ContactError {
             Field::Position(i) => format!("r{ball}[{i}]"),
             Field::Velocity(i) => format!("v{ball}[{i}]"),
             Field::Radius => format!("R{ball}"),
+            Field::Growth => format!("g{ball}"),
         };
         match *self {
             ContactError::NonFinite { ball, field, value } => {
@@ -141,6 +152,9 @@ impl fmt::Display for ContactError {
             }
             ContactError::NegativeRadius { ball, value } => {
                 write!(f, "R{ball} = {value} is negative; a radius must be ≥ 0")
+            }
+            ContactError::NegativeGrowth { ball, value } => {
+                write!(f, "g{ball} = {value} is negative; a growth rate must be ≥ 0 (radii grow or stay)")
             }
         }
     }
@@ -170,15 +184,19 @@ pub fn contact_time<const D: usize>(first: &Ball<D>, second: &Ball<D>) -> Result
 #[cold]
 #[inline(never)]
 fn validated_exact<const D: usize>(first: &Ball<D>, second: &Ball<D>) -> Result<Contact, ContactError> {
-    let valid = [first, second].iter().all(|b| {
-        b.position.iter().chain(&b.velocity).all(|x| x.is_finite()) && b.radius.is_finite() && b.radius >= 0.0
-    });
-    if valid { Ok(exact_full(first, second)) } else { Err(first_invalid(first, second)) }
+    if valid_balls(first, second) { Ok(exact_full(first, second)) } else { Err(first_invalid(first, second)) }
+}
+
+/// Whether both balls have finite coordinates and finite, non-negative radii.
+pub(crate) fn valid_balls<const D: usize>(first: &Ball<D>, second: &Ball<D>) -> bool {
+    [first, second]
+        .iter()
+        .all(|b| b.position.iter().chain(&b.velocity).all(|x| x.is_finite()) && b.radius.is_finite() && b.radius >= 0.0)
 }
 
 /// The first offending input (cold path of [`contact_time`]).
 #[cold]
-fn first_invalid<const D: usize>(first: &Ball<D>, second: &Ball<D>) -> ContactError {
+pub(crate) fn first_invalid<const D: usize>(first: &Ball<D>, second: &Ball<D>) -> ContactError {
     for (ball, b) in [(1u8, first), (2u8, second)] {
         for i in 0..D {
             for (field, value) in [(Field::Position(i), b.position[i]), (Field::Velocity(i), b.velocity[i])] {
@@ -198,7 +216,7 @@ fn first_invalid<const D: usize>(first: &Ball<D>, second: &Ball<D>) -> ContactEr
 }
 
 /// A length or velocity difference held exactly as `hi + lo` (TwoSum output).
-type Pair = (f64, f64);
+pub(crate) type Pair = (f64, f64);
 
 /// [`contact_time`] for inputs already known to be finite with non-negative radii.
 #[inline]
@@ -698,7 +716,7 @@ fn exact_full<const D: usize>(first: &Ball<D>, second: &Ball<D>) -> Contact {
 
 /// `Δr`, `Δv`, `σ` as exact TwoSum pairs, lengths scaled by `2^lpre`, velocities by `2^vpre`.
 #[inline(always)]
-fn differences<const D: usize>(
+pub(crate) fn differences<const D: usize>(
     first: &Ball<D>,
     second: &Ball<D>,
     lpre: i32,
@@ -717,7 +735,7 @@ fn differences<const D: usize>(
 
 /// The largest |head| of Δr and σ; NaN or ∞ (which compare as "not < 2¹⁰²⁰") after overflow.
 #[inline(always)]
-fn max_length<const D: usize>(dr: &[Pair; D], sigma: Pair) -> f64 {
+pub(crate) fn max_length<const D: usize>(dr: &[Pair; D], sigma: Pair) -> f64 {
     let mut m = sigma.0 + sigma.1 * 0.0;
     for p in dr {
         let a = p.0.abs() + p.1 * 0.0;
@@ -728,7 +746,7 @@ fn max_length<const D: usize>(dr: &[Pair; D], sigma: Pair) -> f64 {
 
 /// The largest |head| of Δv (NaN or ∞ after overflow).
 #[inline(always)]
-fn max_velocity<const D: usize>(dv: &[Pair; D]) -> f64 {
+pub(crate) fn max_velocity<const D: usize>(dv: &[Pair; D]) -> f64 {
     let mut m = 0.0;
     for p in dv {
         let a = p.0.abs() + p.1 * 0.0;
@@ -764,15 +782,15 @@ fn contact_of_differences<const D: usize>(dr: &[Pair; D], dv: &[Pair; D], sigma:
 // ---------------------------------------------------------------------------------------
 
 /// Unit roundoff u = 2⁻⁵³.
-const U: f64 = f64::EPSILON / 2.0;
+pub(crate) const U: f64 = f64::EPSILON / 2.0;
 /// Absolute slack covering underflow in the filter: every f64 operation on inputs in
 /// `2^±150` errs by at most 2⁻¹⁰⁷⁵ absolutely through underflow; a few hundred such
 /// operations stay far below 2⁻¹⁰⁰⁰.
-const SLACK: f64 = 1e-300;
+pub(crate) const SLACK: f64 = 1e-300;
 /// A double-double value is used for the root only when its certified relative error is
 /// below 2⁻⁸⁰ — then the root is correctly rounded unless within ~2⁻²⁵ ulp of a midpoint.
 /// Its bound is ~2⁻⁹⁸ of the scale below, so values above 2⁻¹⁸ of the scale qualify.
-const DD_ACCEPT: f64 = 1.0 / (1u64 << 18) as f64;
+pub(crate) const DD_ACCEPT: f64 = 1.0 / (1u64 << 18) as f64;
 
 /// The certified answer, [`Verdict::Beyond`] when the contact is certainly later than
 /// `horizon` (pass `+∞` for none), or [`Verdict::Undecided`] when the exact path must decide
@@ -929,7 +947,7 @@ fn filter_b<const D: usize>(h: &[f64; D], g: &[f64; D]) -> (f64, f64, f64) {
 
 /// `c̃ = |h|² − s²`, `Q = |h|² + s²` and the bound `γ` on `|c − c̃|` (see [`filtered`]).
 #[inline(always)]
-fn filter_c<const D: usize>(h: &[f64; D], s: f64) -> (f64, f64, f64) {
+pub(crate) fn filter_c<const D: usize>(h: &[f64; D], s: f64) -> (f64, f64, f64) {
     let (mut c, mut q) = (-(s * s), s * s);
     for &x in h {
         c = x.mul_add(x, c);
@@ -1036,7 +1054,7 @@ fn widened_ends(
 
 /// A double-double accumulator: heads summed exactly by TwoSum, tails in plain f64.
 #[derive(Default)]
-struct Acc {
+pub(crate) struct Acc {
     hi: f64,
     lo: f64,
 }
@@ -1044,7 +1062,7 @@ struct Acc {
 impl Acc {
     /// Adds `x·y` (exactly split by TwoProd).
     #[inline(always)]
-    fn prod(&mut self, x: f64, y: f64) {
+    pub(crate) fn prod(&mut self, x: f64, y: f64) {
         let (p, e) = two_prod(x, y);
         let (s, f) = two_sum(self.hi, p);
         self.hi = s;
@@ -1052,11 +1070,11 @@ impl Acc {
     }
     /// Adds a small term (already below the heads by a factor ~u).
     #[inline(always)]
-    fn small(&mut self, x: f64) {
+    pub(crate) fn small(&mut self, x: f64) {
         self.lo += x;
     }
     #[inline(always)]
-    fn dd(&self) -> Dd {
+    pub(crate) fn dd(&self) -> Dd {
         Dd::new(self.hi, self.lo)
     }
 }

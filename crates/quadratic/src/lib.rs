@@ -9,6 +9,9 @@
 //!   first touch while approaching, as a [`Contact`] (never — and why —, now, or at `t`).
 //!   The never/now/at classification is exact for the f64 inputs and `t` is within one
 //!   ulp of the exact contact time of those inputs — not of rounded `a`, `b`, `c`.
+//! * [`contact_time_growing`] does the same for balls whose radii grow linearly in time
+//!   (`R + g·t`, Lubachevsky–Stillinger compression), where growth can outrun the motion;
+//!   with no growth it is [`contact_time`], bit for bit.
 //! * [`contact_bracket`] and [`contact_time_within`] serve a search for the earliest of many
 //!   contacts: a certified interval for the time (or "later than the horizon") from the f64
 //!   filter alone, so that only the one or two candidates that can come first pay for the
@@ -46,6 +49,7 @@
 
 pub mod contact;
 pub mod exact;
+pub mod growing;
 pub mod hex;
 pub mod reference;
 pub mod roots;
@@ -57,4 +61,7 @@ pub use contact::{
     Ball, BallLanes, Bracket, Contact, ContactError, Field, Miss, Narrowed, contact_bracket, contact_brackets,
     contact_time, contact_time_unchecked, contact_time_within, narrow_contact,
 };
+#[doc(hidden)]
+pub use growing::contact_time_growing_exact_path;
+pub use growing::{contact_time_growing, contact_time_growing_unchecked};
 pub use roots::{Coefficient, Roots, SolveError, solve};

@@ -8,7 +8,7 @@
 //! machine (`collide check`).
 
 use crate::exact::pow2;
-use crate::{Ball, Contact, Miss, Roots, contact_time, solve, textbook};
+use crate::{Ball, Contact, Miss, Roots, contact_time, contact_time_growing, solve, textbook};
 use std::fmt::Write;
 
 /// A quadratic `a·x² + b·x + c = 0` with its exact roots.
@@ -35,6 +35,21 @@ pub struct ContactCase {
     pub first: Ball<2>,
     /// Disk 2.
     pub second: Ball<2>,
+    /// The exact contact (class and reason exact, time correctly rounded).
+    pub exact: Contact,
+}
+
+/// Two disks whose radii grow at `rates` (`R + g·t`), with their exact contact.
+#[derive(Clone, Copy, Debug)]
+pub struct GrowingCase {
+    /// What the case exercises.
+    pub name: &'static str,
+    /// Disk 1.
+    pub first: Ball<2>,
+    /// Disk 2.
+    pub second: Ball<2>,
+    /// The growth rates `[g₁, g₂]`.
+    pub rates: [f64; 2],
     /// The exact contact (class and reason exact, time correctly rounded).
     pub exact: Contact,
 }
@@ -237,6 +252,80 @@ pub const CONTACT_CASES: &[ContactCase] = &[
     },
 ];
 
+/// The growing-contact cases ([`crate::contact_time_growing`]).
+pub const GROWING_CASES: &[GrowingCase] = &[
+    GrowingCase {
+        name: "at rest 3 apart, σ(t) = 1 + t: growth alone",
+        first: disk(0.0, 0.0, 0.0, 0.0, 0.5),
+        second: disk(3.0, 0.0, 0.0, 0.0, 0.5),
+        rates: [0.5, 0.5],
+        exact: Contact::At(2.0),
+    },
+    GrowingCase {
+        name: "receding at ½ while σ grows at 1 (A < 0, b > 0)",
+        first: disk(0.0, 0.0, 0.0, 0.0, 0.5),
+        second: disk(3.0, 0.0, 0.5, 0.0, 0.5),
+        rates: [0.5, 0.5],
+        exact: Contact::At(4.0),
+    },
+    GrowingCase {
+        name: "relative speed = G = 5 exactly (A = 0): the linear root 2/7",
+        first: disk(0.0, 0.0, 0.0, 0.0, 0.5),
+        second: disk(3.0, 0.0, -3.0, 4.0, 0.5),
+        rates: [2.5, 2.5],
+        exact: Contact::At(bits(0x3fd2492492492492)),
+    },
+    GrowingCase {
+        name: "receding, G one ulp above the relative speed 5 (A < 0): far future contact",
+        first: disk(0.0, 0.0, 0.0, 0.0, 0.5),
+        second: disk(3.0, 0.0, 3.0, 4.0, 0.5),
+        rates: [2.5, bits(0x4004000000000001)],
+        exact: Contact::At(bits(0x431999999999999c)),
+    },
+    GrowingCase {
+        name: "receding, G one ulp below the relative speed 5 (A > 0): never",
+        first: disk(0.0, 0.0, 0.0, 0.0, 0.5),
+        second: disk(3.0, 0.0, 3.0, 4.0, 0.5),
+        rates: [2.5, bits(0x4003ffffffffffff)],
+        exact: Contact::Never(Miss::Receding),
+    },
+    GrowingCase {
+        name: "jammed: gap 10⁻¹⁴σ at rest, growing at 10⁻³",
+        first: disk(0.0, 0.0, 0.0, 0.0, 0.5),
+        second: disk(1.00000000000001, 0.0, 0.0, 0.0, 0.5),
+        rates: [5e-4, 5e-4],
+        exact: Contact::At(bits(0x3da5f90000000000)),
+    },
+    GrowingCase {
+        name: "jammed: gap 2⁻⁵² σ, sliding sideways, growing at 10⁻⁶",
+        first: disk(0.0, 0.0, 0.0, 0.0, 0.5),
+        second: disk(one_plus_ulps(1), 0.0, 0.0, 1e-3, 0.5),
+        rates: [5e-7, 5e-7],
+        exact: Contact::At(bits(0x3dee8480000e8d4b)),
+    },
+    GrowingCase {
+        name: "overlap of 1 ulp, at rest, growing: now",
+        first: disk(0.0, 0.0, 0.0, 0.0, 0.5),
+        second: disk(one_minus_ulps(1), 0.0, 0.0, 0.0, 0.5),
+        rates: [1e-3, 0.0],
+        exact: Contact::Now,
+    },
+    GrowingCase {
+        name: "touching, fleeing faster than growth: never",
+        first: disk(0.0, 0.0, 0.0, 0.0, 0.5),
+        second: disk(1.0, 0.0, 1.0, 0.0, 0.5),
+        rates: [0.25, 0.25],
+        exact: Contact::Never(Miss::Receding),
+    },
+    GrowingCase {
+        name: "lengths ×2⁵⁰⁰, velocities and rates ×2⁻⁵⁰⁰, at rest",
+        first: disk(0.0, 0.0, 0.0, 0.0, pow2(499)),
+        second: disk(3.0 * pow2(500), 0.0, 0.0, 0.0, pow2(499)),
+        rates: [pow2(-501), pow2(-501)],
+        exact: Contact::At(pow2(1001)),
+    },
+];
+
 /// `x` and `y` are equal or adjacent f64 of the same sign (zeros of either sign equal).
 fn within_one_ulp(x: f64, y: f64) -> bool {
     if x == y {
@@ -334,5 +423,14 @@ pub fn check_all() -> Report {
         let [naive, got, exact] = [naive, got, case.exact].map(|c| describe_contact(&c));
         entry(&mut text, ok, case.name, (naive, naive_ok), got, exact);
     }
-    Report { text, cases: ROOT_CASES.len() + CONTACT_CASES.len(), failures }
+    writeln!(text, "Contact time of two growing disks").unwrap();
+    for case in GROWING_CASES {
+        let got = contact_time_growing(&case.first, &case.second, case.rates).expect("reference inputs are valid");
+        let naive = textbook::contact_time_growing(&case.first, &case.second, case.rates);
+        let ok = verdict(contacts_agree(&got, &case.exact));
+        let naive_ok = contacts_agree(&naive, &case.exact);
+        let [naive, got, exact] = [naive, got, case.exact].map(|c| describe_contact(&c));
+        entry(&mut text, ok, case.name, (naive, naive_ok), got, exact);
+    }
+    Report { text, cases: ROOT_CASES.len() + CONTACT_CASES.len() + GROWING_CASES.len(), failures }
 }

@@ -63,3 +63,39 @@ pub fn contact_time<const D: usize>(first: &Ball<D>, second: &Ball<D>) -> Contac
         Contact::At(t)
     }
 }
+
+/// The growing-contact time as a careful textbook code writes it, in plain f64:
+/// `A = |Δv|² − G²`, `B = 2(⟨Δv|Δr⟩ − σG)`, `C = |Δr|² − σ²`; `C ≤ 0` → now if `B < 0`,
+/// else never; `A = 0` → the linear root `−C/B` when `B < 0`; otherwise
+/// `t = (−B − √(B² − 4AC)) / 2A` for `A > 0` (never if `B ≥ 0` or the discriminant is not
+/// positive) and `t = (−B − √(B² − 4AC)) / 2A` for `A < 0` too (the positive root).
+pub fn contact_time_growing<const D: usize>(first: &Ball<D>, second: &Ball<D>, rates: [f64; 2]) -> Contact {
+    let (mut a, mut b, mut c) = (0.0, 0.0, 0.0);
+    for i in 0..D {
+        let dr = second.position[i] - first.position[i];
+        let dv = second.velocity[i] - first.velocity[i];
+        a += dv * dv;
+        b += 2.0 * dv * dr;
+        c += dr * dr;
+    }
+    let sigma = first.radius + second.radius;
+    let grow = rates[0] + rates[1];
+    a -= grow * grow;
+    b -= 2.0 * sigma * grow;
+    c -= sigma * sigma;
+    if c <= 0.0 {
+        return if b < 0.0 { Contact::Now } else { Contact::Never(Miss::Receding) };
+    }
+    if a == 0.0 {
+        return if b < 0.0 { Contact::At(-c / b) } else { Contact::Never(Miss::Receding) };
+    }
+    if a > 0.0 && b >= 0.0 {
+        return Contact::Never(Miss::Receding);
+    }
+    let disc = b * b - 4.0 * a * c;
+    if disc.is_nan() || disc <= 0.0 {
+        return Contact::Never(Miss::PathsMiss);
+    }
+    let t = (-b - disc.sqrt()) / (2.0 * a);
+    if t.is_nan() { Contact::Never(Miss::PathsMiss) } else { Contact::At(t) }
+}

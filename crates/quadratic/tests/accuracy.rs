@@ -4,13 +4,13 @@
 //! Each family runs as a proptest property with a fixed seed (`common::runner`): a
 //! violation of the contract fails the test with the shrunk counterexample. While the
 //! properties run, the same cases are scored for the table printed at the end (and written
-//! to `target/tmp/accuracy-table.md`): misclassifications and max ulp error, for collide
+//! to `target/tmp/accuracy-<title>.md`): misclassifications and max ulp error, for collide
 //! and for the textbook formula. The table documents; only collide's columns are asserted.
 
 mod common;
 
-use common::families::{contact_families, contact_families_3d, quadratic_families};
-use common::oracle::{check_roots, class3, exact_contact};
+use common::families::{Grow, contact_families, contact_families_3d, growing_families, quadratic_families};
+use common::oracle::{check_roots, class3, exact_contact, exact_contact_growing};
 use common::runner;
 use proptest::prelude::*;
 use proptest::strategy::BoxedStrategy;
@@ -61,7 +61,9 @@ fn publish(title: &str, rows: &[String]) {
     let table = format!("### {title}\n\n{HEADER}\n{}\n", rows.join("\n"));
     println!("{table}");
     let dir = std::path::Path::new(env!("CARGO_TARGET_TMPDIR"));
-    let path = dir.join(format!("accuracy-{}.md", title.split_whitespace().next().unwrap().to_lowercase()));
+    let slug: String =
+        title.to_lowercase().chars().filter(|c| c.is_alphanumeric() || *c == ' ').collect::<String>().replace(' ', "-");
+    let path = dir.join(format!("accuracy-{slug}.md"));
     std::fs::write(path, &table).unwrap();
 }
 
@@ -151,6 +153,84 @@ fn contact_time_contract_on_every_family_2d() {
 #[test]
 fn contact_time_contract_on_every_family_3d() {
     publish("Contact time (3D)", &score_contacts(contact_families_3d()));
+}
+
+fn score_growing<const D: usize>(families: Vec<(&'static str, BoxedStrategy<Grow<D>>)>) -> Vec<String> {
+    let mut rows = Vec::new();
+    for (name, strategy) in families {
+        let score = RefCell::new(Score::default());
+        let result = runner(CASES).run(&strategy, |(p, q, rates)| {
+            let got = quadratic::contact_time_growing(&p, &q, rates).expect("valid inputs");
+            // The exact path alone must give the identical answer: both paths are proved.
+            let slow = quadratic::contact_time_growing_exact_path(&p, &q, rates);
+            prop_assert_eq!(got, slow, "filter and exact path disagree for {:?} {:?} {:?}", p, q, rates);
+            let exact = exact_contact_growing(&p, &q, rates);
+            let naive = textbook::contact_time_growing(&p, &q, rates);
+            let ulps = |c: &Contact| match *c {
+                Contact::At(t) => exact.ulps(t),
+                _ => 0.0,
+            };
+            let class_ok = std::mem::discriminant(&got) == std::mem::discriminant(&exact.class)
+                && (matches!(got, Contact::At(_)) || got == exact.class);
+            let u = if class_ok { ulps(&got) } else { 0.0 };
+            let mut s = score.borrow_mut();
+            s.cases += 1;
+            s.wrong += usize::from(!class_ok);
+            s.max_ulps = s.max_ulps.max(u);
+            if class3(&naive) == class3(&exact.class) {
+                let nu = ulps(&naive);
+                s.textbook_over_1ulp += usize::from(!(nu <= 1.0));
+                s.textbook_max_ulps = s.textbook_max_ulps.max(nu);
+            } else {
+                s.textbook_wrong += 1;
+            }
+            drop(s);
+            prop_assert!(class_ok, "{p:?} {q:?} {rates:?}: got {got:?}, exact {:?}", exact.class);
+            prop_assert!(u <= 1.0, "{p:?} {q:?} {rates:?}: {got:?} is {u} ulp from the exact time");
+            Ok(())
+        });
+        if let Err(e) = result {
+            panic!("family '{name}': {e}");
+        }
+        rows.push(row(name, &score.into_inner()));
+    }
+    rows
+}
+
+#[test]
+fn growing_contact_contract_on_every_family_2d() {
+    publish("Growing contact (2D)", &score_growing(growing_families::<2>()));
+}
+
+#[test]
+fn growing_contact_contract_on_every_family_3d() {
+    publish("Growing contact (3D)", &score_growing(growing_families::<3>()));
+}
+
+/// Without growth the growing kernel is the rigid one, bit for bit — through its public
+/// entry (which says so by construction) and through its own exact path (the general
+/// formulas with `G = 0`: the same exact values, rounded the same way), on every rigid family.
+#[test]
+fn growing_kernel_without_growth_is_the_rigid_kernel() {
+    fn check<const D: usize>(families: Vec<(&'static str, BoxedStrategy<(Ball<D>, Ball<D>)>)>) {
+        for (name, strategy) in families {
+            let result = runner(CASES / 4).run(&strategy, |(p, q)| {
+                let rigid = quadratic::contact_time(&p, &q).expect("valid inputs");
+                for rates in [[0.0, 0.0], [-0.0, 0.0], [0.0, -0.0]] {
+                    let grown = quadratic::contact_time_growing(&p, &q, rates).expect("valid inputs");
+                    prop_assert_eq!(format!("{grown:?}"), format!("{rigid:?}"));
+                }
+                let general = quadratic::contact_time_growing_exact_path(&p, &q, [0.0, 0.0]);
+                prop_assert_eq!(format!("{general:?}"), format!("{rigid:?}"), "{:?} {:?}", p, q);
+                Ok(())
+            });
+            if let Err(e) = result {
+                panic!("family '{name}': {e}");
+            }
+        }
+    }
+    check(contact_families());
+    check(contact_families_3d());
 }
 
 /// `contact_time_within` and `contact_bracket` may drop a pair only when its exact contact
@@ -289,6 +369,18 @@ fn oracle_detects_wrong_answers() {
     assert!(exact.ulps(1.0) < 1e-9);
     assert!(exact.ulps(nudge(1.0, 2)) >= 1.9);
     assert!(exact.ulps(nudge(1.0, -2)) >= 1.9);
+    // Growing disks at rest 3 apart, σ(t) = 1 + t: t = 2 (A < 0); 2 ± 2 ulps is caught.
+    let (p, q) = (Ball { velocity: [0.0, 0.0], ..p }, Ball { velocity: [0.0, 0.0], ..q });
+    let exact = exact_contact_growing(&p, &q, [0.5, 0.5]);
+    assert_eq!(class3(&exact.class), 2);
+    assert!(exact.ulps(2.0) < 1e-9 && exact.ulps(nudge(2.0, 2)) >= 1.9 && exact.ulps(nudge(2.0, -2)) >= 1.9);
+    // Head on at |Δv| = G = 1 (A = 0): 3 − t = 1 + t at t = 1, the linear root.
+    let q = Ball { velocity: [-1.0, 0.0], ..q };
+    let exact = exact_contact_growing(&p, &q, [0.5, 0.5]);
+    assert!(exact.ulps(1.0) < 1e-9 && exact.ulps(nudge(1.0, 2)) >= 1.9);
+    // Receding at 2 against a growth of 1 (A > 0, b > 0): never, not a contact.
+    let q = Ball { velocity: [2.0, 0.0], ..q };
+    assert_eq!(exact_contact_growing(&p, &q, [0.5, 0.5]).class, Contact::Never(quadratic::Miss::Receding));
 }
 
 /// The brackets of near-contact pairs are tight: some tens of ulps of the contact time, not

@@ -7,10 +7,10 @@
 
 mod common;
 
-use common::oracle::{exact_contact, roots_rounded};
+use common::oracle::{exact_contact, exact_contact_growing, roots_rounded};
 use quadratic::hex::format as hex;
-use quadratic::reference::{CONTACT_CASES, ROOT_CASES, describe_contact, describe_roots};
-use quadratic::{Contact, Roots, contact_time, solve, textbook};
+use quadratic::reference::{CONTACT_CASES, GROWING_CASES, ROOT_CASES, describe_contact, describe_roots};
+use quadratic::{Contact, Roots, contact_time, contact_time_growing, solve, textbook};
 
 fn exact_roots(a: f64, b: f64, c: f64) -> Roots {
     match roots_rounded(a, b, c) {
@@ -65,6 +65,24 @@ fn stored_exact_answers_are_exact() {
             wrong.push(format!("{}: stored {:?}, exact: {fix}", case.name, case.exact));
         }
     }
+    for case in GROWING_CASES {
+        let exact = exact_contact_growing(&case.first, &case.second, case.rates);
+        let exact = match exact.class {
+            Contact::At(_) => Contact::At(exact.time_rounded()),
+            other => other,
+        };
+        let same = match (exact, case.exact) {
+            (Contact::At(x), Contact::At(y)) => x.to_bits() == y.to_bits(),
+            (x, y) => x == y,
+        };
+        if !same {
+            let fix = match exact {
+                Contact::At(t) => format!("Contact::At({})", literal(t)),
+                other => format!("Contact::{other:?}"),
+            };
+            wrong.push(format!("{}: stored {:?}, exact: {fix}", case.name, case.exact));
+        }
+    }
     assert!(wrong.is_empty(), "stored reference answers are wrong:\n{}", wrong.join("\n"));
 }
 
@@ -99,17 +117,17 @@ fn table() -> String {
     }
     out.push_str("\n### Contact time of two disks\n\n");
     out.push_str("| case | r₁; v₁; R₁ | r₂; v₂; R₂ | textbook formula | collide | exact (correctly rounded) |\n|---|---|---|---|---|---|\n");
+    let ball = |b: &quadratic::Ball<2>| {
+        format!(
+            "`({}, {})`; `({}, {})`; `{}`",
+            hex(b.position[0]),
+            hex(b.position[1]),
+            hex(b.velocity[0]),
+            hex(b.velocity[1]),
+            hex(b.radius)
+        )
+    };
     for c in CONTACT_CASES {
-        let ball = |b: &quadratic::Ball<2>| {
-            format!(
-                "`({}, {})`; `({}, {})`; `{}`",
-                hex(b.position[0]),
-                hex(b.position[1]),
-                hex(b.velocity[0]),
-                hex(b.velocity[1]),
-                hex(b.radius)
-            )
-        };
         let naive = textbook::contact_time(&c.first, &c.second);
         let got = contact_time(&c.first, &c.second).unwrap();
         out.push_str(&format!(
@@ -117,6 +135,24 @@ fn table() -> String {
             c.name,
             ball(&c.first),
             ball(&c.second),
+            describe_contact(&naive),
+            mark(quadratic::reference::contacts_agree(&naive, &c.exact)),
+            describe_contact(&got),
+            describe_contact(&c.exact)
+        ));
+    }
+    out.push_str("\n### Contact time of two growing disks (radius `R + g·t`)\n\n");
+    out.push_str("| case | r₁; v₁; R₁ | r₂; v₂; R₂ | g₁, g₂ | textbook formula | collide | exact (correctly rounded) |\n|---|---|---|---|---|---|---|\n");
+    for c in GROWING_CASES {
+        let naive = textbook::contact_time_growing(&c.first, &c.second, c.rates);
+        let got = contact_time_growing(&c.first, &c.second, c.rates).unwrap();
+        out.push_str(&format!(
+            "| {} | {} | {} | `{}`, `{}` | {}{} | {} | {} |\n",
+            c.name,
+            ball(&c.first),
+            ball(&c.second),
+            hex(c.rates[0]),
+            hex(c.rates[1]),
             describe_contact(&naive),
             mark(quadratic::reference::contacts_agree(&naive, &c.exact)),
             describe_contact(&got),

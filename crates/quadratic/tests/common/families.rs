@@ -313,3 +313,207 @@ pub fn contact_families_3d() -> Vec<(&'static str, BoxedStrategy<Pair3>)> {
         ),
     ]
 }
+
+/// Two balls and their growth rates `[g₁, g₂]`.
+pub type Grow<const D: usize> = (Ball<D>, Ball<D>, [f64; 2]);
+
+/// The first `D` components.
+fn take<const D: usize>(v: [f64; 3]) -> [f64; D] {
+    core::array::from_fn(|i| v[i])
+}
+
+/// A unit vector in `D` dimensions from three uniform numbers (the x axis if degenerate).
+fn direction<const D: usize>(v: [f64; 3]) -> [f64; D] {
+    let v: [f64; D] = take(v);
+    let n = v.iter().map(|x| x * x).sum::<f64>().sqrt();
+    if n < 1e-3 { core::array::from_fn(|i| if i == 0 { 1.0 } else { 0.0 }) } else { v.map(|x| x / n) }
+}
+
+/// Integer vectors with an integer length: Pythagorean triples (2D) and quadruples (3D).
+fn pythagorean<const D: usize>(k: usize) -> ([f64; D], f64) {
+    const TRIPLES: [([f64; 3], f64); 5] = [
+        ([3.0, 4.0, 0.0], 5.0),
+        ([5.0, 12.0, 0.0], 13.0),
+        ([8.0, 15.0, 0.0], 17.0),
+        ([7.0, 24.0, 0.0], 25.0),
+        ([20.0, 21.0, 0.0], 29.0),
+    ];
+    const QUADRUPLES: [([f64; 3], f64); 5] = [
+        ([1.0, 2.0, 2.0], 3.0),
+        ([2.0, 3.0, 6.0], 7.0),
+        ([1.0, 4.0, 8.0], 9.0),
+        ([4.0, 4.0, 7.0], 9.0),
+        ([2.0, 6.0, 9.0], 11.0),
+    ];
+    let (v, n) = if D == 2 { TRIPLES[k % 5] } else { QUADRUPLES[k % 5] };
+    (take(v), n)
+}
+
+/// A relative velocity of exactly length `G = g₁ + g₂` (so `A = 0` exactly): a Pythagorean
+/// vector with random signs, scaled by 2^e, added to a dyadic `v₁` (so `v₂ − v₁` is exact);
+/// the rates split `G` dyadically. `nudge_g2` then moves `g₂` by that many ulps.
+fn exact_a_zero<const D: usize>() -> impl Strategy<Value = ([f64; D], [f64; D], [f64; 2])> {
+    (0usize..5, proptest::array::uniform3(any::<bool>()), -3i32..=3, proptest::array::uniform3(-16i32..=16), 1u32..8)
+        .prop_map(|(k, signs, e, v1, split)| {
+            let (v, n) = pythagorean::<D>(k);
+            let scale = scale2(1.0, e);
+            let dv: [f64; D] = core::array::from_fn(|i| if signs[i] { -v[i] } else { v[i] } * scale);
+            let v1: [f64; D] = core::array::from_fn(|i| v1[i] as f64 / 8.0);
+            let v2: [f64; D] = core::array::from_fn(|i| v1[i] + dv[i]);
+            let grow = n * scale;
+            let g1 = grow * split as f64 / 8.0;
+            (v1, v2, [g1, grow - g1])
+        })
+}
+
+/// Growing-contact families in `D` dimensions: each targets a way the growing quadratic is
+/// hard (`A` of any sign and near zero, growth-dominated pairs, jammed gaps, overlaps by
+/// ulps, extreme scales).
+pub fn growing_families<const D: usize>() -> Vec<(&'static str, BoxedStrategy<Grow<D>>)> {
+    let radius = || 0.25..1.0f64;
+    let coordinates = || proptest::array::uniform3(-10.0..10.0f64);
+    let unit3 = || proptest::array::uniform3(-1.0..1.0f64);
+    vec![
+        (
+            // |Δv| = G exactly: f is linear, or the pair overlaps; apart by 0.5–4σ.
+            "A = 0 exactly (relative speed = G)",
+            (exact_a_zero::<D>(), coordinates(), unit3(), 0.5..4.0f64, radius(), radius())
+                .prop_map(|((v1, v2, rates), p, dir, dist, r1, r2)| {
+                    let p: [f64; D] = take(p);
+                    let u: [f64; D] = direction(dir);
+                    let q = core::array::from_fn(|i| p[i] + dist * (r1 + r2) * u[i]);
+                    (ball(p, v1, r1), ball(q, v2, r2), rates)
+                })
+                .boxed(),
+        ),
+        (
+            // The same with g₂ moved by ±1…6 ulps: A a few ulps of G² either side of 0.
+            "A within ulps of 0",
+            (exact_a_zero::<D>(), coordinates(), unit3(), 1.0..4.0f64, radius(), radius(), 1i64..=6, any::<bool>())
+                .prop_map(|((v1, v2, rates), p, dir, dist, r1, r2, k, down)| {
+                    let p: [f64; D] = take(p);
+                    let u: [f64; D] = direction(dir);
+                    let q = core::array::from_fn(|i| p[i] + dist * (r1 + r2) * u[i]);
+                    (ball(p, v1, r1), ball(q, v2, r2), [rates[0], nudge(rates[1], if down { -k } else { k })])
+                })
+                .boxed(),
+        ),
+        (
+            // Full-precision velocities whose difference rounds, G the f64 length of the
+            // rounded difference moved by −3…3 ulps: A is a few ulps of G² from 0 and its
+            // f64 evaluation is off in the last bits (the filter must not trust it).
+            "A within ulps of 0 (rounded Δv)",
+            (
+                proptest::array::uniform3(-2.0..2.0f64),
+                unit3(),
+                0.1..2.0f64,
+                -3i64..=3,
+                0.5..1.0f64,
+                coordinates(),
+                unit3(),
+                1.0..4.0f64,
+                radius(),
+            )
+                .prop_map(|(v1, w, speed, k, split, p, dir, dist, r)| {
+                    let v1: [f64; D] = take(v1);
+                    let w: [f64; D] = direction(w);
+                    let v2: [f64; D] = core::array::from_fn(|i| v1[i] + speed * w[i]);
+                    let grow = nudge((0..D).map(|i| (v2[i] - v1[i]).powi(2)).sum::<f64>().sqrt(), k);
+                    // g₂ = G − g₁ is exact (Sterbenz: g₁ within a factor 2 of G), so g₁ + g₂ = G.
+                    let g1 = grow * split;
+                    let p: [f64; D] = take(p);
+                    let u: [f64; D] = direction(dir);
+                    let q = core::array::from_fn(|i| p[i] + dist * 2.0 * r * u[i]);
+                    (ball(p, v1, r), ball(q, v2, r), [g1, grow - g1])
+                })
+                .boxed(),
+        ),
+        (
+            // |Δv| = 10⁻⁸…10⁻¹ of G, any direction: A < 0, contact whether approaching or not.
+            "growth-dominated",
+            (coordinates(), unit3(), unit3(), 1.0..3.0f64, -8.0..-1.0f64, 0.01..2.0f64, 0.0..1.0f64, radius())
+                .prop_map(|(p, dir, w, dist, lv, grow, split, r)| {
+                    let p: [f64; D] = take(p);
+                    let u: [f64; D] = direction(dir);
+                    let w: [f64; D] = direction(w);
+                    let q = core::array::from_fn(|i| p[i] + dist * 2.0 * r * u[i]);
+                    let speed = grow * 10f64.powf(lv);
+                    (ball(p, [0.0; D], r), ball(q, w.map(|x| x * speed), r), [grow * split, grow * (1.0 - split)])
+                })
+                .boxed(),
+        ),
+        (
+            // Gaps of 10⁻¹⁴…10⁻⁶σ, velocities 10⁻³…1, growth 10⁻⁴…10⁻¹: a pair near jamming,
+            // approaching, receding, or sliding.
+            "jammed gaps 1e-14..1e-6",
+            (coordinates(), unit3(), unit3(), -14.0..-6.0f64, -3.0..0.0f64, -4.0..-1.0f64, radius(), radius())
+                .prop_map(|(p, dir, w, lgap, lv, lg, r1, r2)| {
+                    let p: [f64; D] = take(p);
+                    let u: [f64; D] = direction(dir);
+                    let w: [f64; D] = direction(w);
+                    let d = (r1 + r2) * (1.0 + 10f64.powf(lgap));
+                    let q = core::array::from_fn(|i| p[i] + d * u[i]);
+                    let speed = 10f64.powf(lv);
+                    let g = 10f64.powf(lg);
+                    (ball(p, [0.0; D], r1), ball(q, w.map(|x| x * speed), r2), [g * r1, g * r2])
+                })
+                .boxed(),
+        ),
+        (
+            // Overlap of 0–8 ulps of σ, approaching, separating or tangential, with growth
+            // (proportional to the radii) or without.
+            "overlap by ulps, with and without growth",
+            (radius(), radius(), 0i64..=8, unit3(), 0u8..3, 0.1..2.0f64, prop_oneof![Just(0.0), 1e-6..1.0f64])
+                .prop_map(|(r1, r2, k, dir, mode, s, g)| {
+                    let u: [f64; D] = direction(dir);
+                    let f = (r1 + r2) * (1.0 - k as f64 * f64::EPSILON);
+                    let d: [f64; D] = u.map(|x| x * f);
+                    let v: [f64; D] = match mode {
+                        0 => d.map(|x| -x * s),
+                        1 => d.map(|x| x * s),
+                        // ⟨v|d⟩ = 0 up to the roundings of v: (−d₁, d₀, 0)·s.
+                        _ => core::array::from_fn(|i| match i {
+                            0 => -d[1] * s,
+                            1 => d[0] * s,
+                            _ => 0.0,
+                        }),
+                    };
+                    (ball([0.0; D], [0.0; D], r1), ball(d, v, r2), [g * r1, g * r2])
+                })
+                .boxed(),
+        ),
+        (
+            // A random pair 1–2.5σ apart with growth, lengths scaled by 2^p and velocities
+            // and rates by 2^q, |p|, |q| ≤ 500.
+            "scaled 2^±500",
+            (growing_pair::<D>(), -500i32..=500, -500i32..=500)
+                .prop_map(|((p, q, rates), lp, lv)| {
+                    let s = |b: Ball<D>| Ball {
+                        position: b.position.map(|x| scale2(x, lp)),
+                        velocity: b.velocity.map(|x| scale2(x, lv)),
+                        radius: scale2(b.radius, lp),
+                    };
+                    (s(p), s(q), rates.map(|g| scale2(g, lv)))
+                })
+                .boxed(),
+        ),
+        ("compressing-fluid pairs", growing_pair::<D>().boxed()),
+    ]
+}
+
+/// A pair as it occurs in a compression: positions in a 100σ box, 1–2.5σ apart, velocity
+/// components in [−2, 2], radii 0.5 growing at 0…0.5 of themselves per unit time.
+pub fn growing_pair<const D: usize>() -> impl Strategy<Value = Grow<D>> {
+    (proptest::array::uniform3(0.0..100.0f64), proptest::array::uniform3(-1.0..1.0f64), 1.0..2.5f64)
+        .prop_flat_map(|(p, dir, dist)| {
+            (Just((p, dir, dist)), proptest::array::uniform6(-2.0..2.0f64), 0.0..0.5f64, 0.5..2.0f64)
+        })
+        .prop_map(|((p, dir, dist), v, rate, ratio)| {
+            let p: [f64; D] = take(p);
+            let u: [f64; D] = direction(dir);
+            let q = core::array::from_fn(|i| p[i] + dist * u[i]);
+            let (r1, r2) = (0.5, 0.5 * ratio);
+            let (v1, v2) = (take([v[0], v[1], v[2]]), take([v[3], v[4], v[5]]));
+            (ball(p, v1, r1), ball(q, v2, r2), [rate * r1, rate * r2])
+        })
+}

@@ -222,13 +222,15 @@ pub struct RootCheck {
     pub max_ulps: f64,
 }
 
-/// The exact contact of two balls, and its time as the triple (b, D, a) with
-/// t = (−b − √D)/a, when it is `At`.
+/// The exact contact of two balls, and its time from the gap function a·t² + 2b·t + c with
+/// D = b² − a·c: t = (−b − √D)/a when `At` and a ≠ 0 (for either sign of a: with a < 0 that
+/// is the single positive root), t = −c/(2b) when a = 0 (growing balls only).
 pub struct ExactContact {
     pub class: Contact,
     b: Dy,
     disc: Dy,
     a: Dy,
+    c: Dy,
 }
 
 pub fn exact_contact<const D: usize>(p: &Ball<D>, q: &Ball<D>) -> ExactContact {
@@ -256,7 +258,56 @@ pub fn exact_contact<const D: usize>(p: &Ball<D>, q: &Ball<D>) -> ExactContact {
     } else {
         Contact::At(f64::NAN)
     };
-    ExactContact { class, b, disc, a }
+    ExactContact { class, b, disc, a, c }
+}
+
+/// The exact contact of two balls whose radii grow at `rates` (≥ 0): the semantics table of
+/// `quadratic::growing`, evaluated on big integers. A = |Δv|² − G², b = ⟨Δr|Δv⟩ − σG,
+/// C = |Δr|² − σ², D = b² − A·C, all exact.
+pub fn exact_contact_growing<const D: usize>(p: &Ball<D>, q: &Ball<D>, rates: [f64; 2]) -> ExactContact {
+    let mut dvsq = Dy::zero();
+    let mut b = Dy::zero();
+    let mut c = Dy::zero();
+    for i in 0..D {
+        let dr = Dy::from_f64(q.position[i]).sub(&Dy::from_f64(p.position[i]));
+        let dv = Dy::from_f64(q.velocity[i]).sub(&Dy::from_f64(p.velocity[i]));
+        dvsq = dvsq.add(&dv.mul(&dv));
+        b = b.add(&dr.mul(&dv));
+        c = c.add(&dr.mul(&dr));
+    }
+    let sigma = Dy::from_f64(p.radius).add(&Dy::from_f64(q.radius));
+    let grow = Dy::from_f64(rates[0]).add(&Dy::from_f64(rates[1]));
+    c = c.sub(&sigma.mul(&sigma));
+    b = b.sub(&sigma.mul(&grow));
+    let a = dvsq.sub(&grow.mul(&grow));
+    let disc = b.mul(&b).sub(&a.mul(&c));
+    let at = Contact::At(f64::NAN);
+    let class = if dvsq.is_zero() && grow.is_zero() {
+        Contact::Never(Miss::NoRelativeMotion)
+    } else if c.sign() <= 0 {
+        if b.sign() < 0 { Contact::Now } else { Contact::Never(Miss::Receding) }
+    } else {
+        match a.sign() {
+            -1 => at,
+            0 => {
+                if b.sign() < 0 {
+                    at
+                } else {
+                    Contact::Never(Miss::Receding)
+                }
+            }
+            _ => {
+                if b.sign() >= 0 {
+                    Contact::Never(Miss::Receding)
+                } else if disc.sign() <= 0 {
+                    Contact::Never(Miss::PathsMiss)
+                } else {
+                    at
+                }
+            }
+        }
+    };
+    ExactContact { class, b, disc, a, c }
 }
 
 /// Three-way class: 0 never, 1 now, 2 at.
@@ -275,8 +326,18 @@ impl ExactContact {
             return f64::INFINITY;
         }
         if t.is_infinite() {
-            let est = self.b.neg().ratio(&self.a);
+            let est = if self.a.is_zero() {
+                self.c.ratio(&self.b.neg()) / 2.0
+            } else {
+                let root = self.disc.sqrt_within(self.disc.log2() / 2 - 80);
+                self.b.neg().sub(&root).ratio(&self.a)
+            };
             return if est >= f64::MAX / 2.0 { 0.0 } else { f64::INFINITY };
+        }
+        if self.a.is_zero() {
+            // 2b·t + c = 0: |2b·t + c| / |2b·gap|.
+            let two_b = Dy::from_f64(2.0).mul(&self.b);
+            return Dy::from_f64(t).mul(&two_b).add(&self.c).ratio(&two_b.mul(&gap(t)).abs()).abs();
         }
         ulps_from_root(t, &self.b.neg(), -1, &self.disc, &self.a)
     }
@@ -291,8 +352,15 @@ impl ExactContact {
     }
     /// The exact contact time, correctly rounded (for the edge-case table).
     pub fn time_rounded(&self) -> f64 {
+        if self.a.is_zero() {
+            return divide(&self.c, &Dy::from_f64(-2.0).mul(&self.b), 200).to_f64();
+        }
         let root = self.disc.sqrt_within(self.disc.log2() / 2 - 200);
-        // t = (−b − √D)/a: a long division at 200 extra bits.
+        if self.b.sign() <= 0 {
+            // t = c/(−b + √D), both terms non-negative: no cancellation when a ≈ 0.
+            return divide(&self.c, &self.b.neg().add(&root), 200).to_f64();
+        }
+        // t = (−b − √D)/a (a < 0 here), both terms of the numerator negative.
         let num = self.b.neg().sub(&root);
         divide(&num, &self.a, 200).to_f64()
     }
