@@ -21,7 +21,7 @@ use collide::engine::init::{Placement, Species, Velocities, box_for_packing_frac
 use collide::engine::internals::{
     EventQueue, LANES, Lanes, PairBracket, QueueKind, bracket_neighbours, bracket_pair, pair_positions,
 };
-use collide::engine::{Boundary, Simulation};
+use collide::engine::{Boundary, Radii, Simulation};
 use collide::engine::{Event, EventKind};
 use criterion::{BenchmarkId, Criterion, Throughput, criterion_group, criterion_main};
 use rand::rngs::Xoshiro256PlusPlus;
@@ -139,7 +139,7 @@ fn parts(c: &mut Criterion) {
             let mut n = 0.0;
             for &(i, j) in &pairs {
                 if let PairBracket::Between { lo, .. } =
-                    bracket_pair(&ps[i], &ps[j], sim_box, black_box(now), &[false; 2], f64::INFINITY)
+                    bracket_pair(&ps[i], &ps[j], sim_box, black_box(now), &[false; 2], f64::INFINITY, Radii::Fixed)
                 {
                     n += lo;
                 }

@@ -244,10 +244,11 @@ fn sampling_below_clock_resolution_does_not_hang() {
 
 /// A pair's predicted contact does not depend on which particle comes first — to the bit,
 /// with lazily updated states at different times, across periodic images, with short axes
-/// (several images tried), walls, unequal radii, and near-misses. The batch search relies on
-/// it: its lanes put the predicted particle first whatever the indices.
+/// (several images tried), walls, unequal radii, near-misses, and growing radii. The batch
+/// search relies on it: its lanes put the predicted particle first whatever the indices.
 #[test]
 fn pair_predictions_do_not_depend_on_the_order_of_the_pair() {
+    use collide::engine::Radii;
     use collide::engine::sources::pair::{bracket as bracket_pair, predict as predict_pair};
     use rand::rngs::Xoshiro256PlusPlus;
     use rand::{RngExt, SeedableRng};
@@ -258,9 +259,10 @@ fn pair_predictions_do_not_depend_on_the_order_of_the_pair() {
         (SimBox { lengths: Vector2::new(3.0, 20.0), boundary: [Boundary::Periodic; 2] }, [true, false]),
     ];
     let (mut hits, mut tested) = (0, 0);
-    for (sim_box, short) in &boxes {
-        for _ in 0..20_000 {
+    for ((sim_box, short), grow) in boxes.iter().flat_map(|b| [(b, false), (b, true)]) {
+        for _ in 0..10_000 {
             let (l, now) = (sim_box.lengths, rng.random_range(0.0..50.0));
+            let radii = if grow { Radii::Growing { rate: 0.05, origin: now - 2.0 } } else { Radii::Fixed };
             let state = |rng: &mut Xoshiro256PlusPlus, x: f64, y: f64| {
                 let (ti, r) = (now - rng.random_range(0.0..1.0), rng.random_range(0.2..0.6));
                 let v = Vector2::new(rng.random_range(-2.0..2.0), rng.random_range(-2.0..2.0));
@@ -276,13 +278,13 @@ fn pair_predictions_do_not_depend_on_the_order_of_the_pair() {
             // A neighbour one to three radii away at `now`, possibly across the boundary.
             let (dx, dy) = (rng.random_range(-2.0..2.0), rng.random_range(-2.0..2.0));
             let q = state(&mut rng, x + dx, y + dy);
-            let forward = predict_pair(&p, &q, sim_box, now, short);
-            let backward = predict_pair(&q, &p, sim_box, now, short);
+            let forward = predict_pair(&p, &q, sim_box, now, short, radii);
+            let backward = predict_pair(&q, &p, sim_box, now, short, radii);
             assert_eq!(forward.map(f64::to_bits), backward.map(f64::to_bits), "{p:?} {q:?} at {now}");
             let horizon = now + rng.random_range(0.0..2.0);
             assert_eq!(
-                bracket_pair(&p, &q, sim_box, now, short, horizon),
-                bracket_pair(&q, &p, sim_box, now, short, horizon),
+                bracket_pair(&p, &q, sim_box, now, short, horizon, radii),
+                bracket_pair(&q, &p, sim_box, now, short, horizon, radii),
                 "{p:?} {q:?} at {now}"
             );
             hits += forward.is_some() as usize;

@@ -113,6 +113,47 @@ pub fn resolve_pair<const D: usize>(first: &mut Body<D>, second: &mut Body<D>, e
     Impulse { on_second: j, normal }
 }
 
+/// [`resolve_pair`] for bodies whose contact distance grows at `growth` (the sum of the two
+/// radii's growth speeds, ≥ 0; Lubachevsky–Stillinger compression): the rule acts on the
+/// *gap's* closing speed `⟨w | n̂⟩ + G` instead of `⟨w | n̂⟩`,
+///
+/// `J = (1 + e)·μ·((⟨w | n⟩ + G·|n|) / |n|²)·n`,
+///
+/// so that afterwards the normal relative velocity `u = ⟨v₂ − v₁ | n̂⟩` is
+/// `u' = G + e·(G − u)`: for `e = 1` the pair separates at `2G − u ≥ G`, at least as fast
+/// as it grows (Donev, Torquato & Stillinger, J. Comput. Phys. 202, 737 (2005)), and kinetic
+/// energy is injected (a compression holds kT with a thermostat). A pair whose gap is not
+/// closing is left alone. With `G = 0` the impulse is [`resolve_pair`]'s.
+///
+/// ```
+/// use collide::engine::{Body, Restitution, resolve_growing_pair};
+/// use nalgebra::vector;
+/// // Equal masses at rest, touching, the gap closing at G = 1: they leave at ±1.
+/// let mut a = Body { position: vector![0.0, 0.0], velocity: vector![0.0, 0.0], mass: 1.0 };
+/// let mut b = Body { position: vector![1.0, 0.0], velocity: vector![0.0, 0.0], mass: 1.0 };
+/// resolve_growing_pair(&mut a, &mut b, Restitution::ELASTIC, 1.0);
+/// assert_eq!((a.velocity, b.velocity), (vector![-1.0, 0.0], vector![1.0, 0.0]));
+/// ```
+pub fn resolve_growing_pair<const D: usize>(
+    first: &mut Body<D>,
+    second: &mut Body<D>,
+    e: Restitution,
+    growth: f64,
+) -> Impulse<D> {
+    let normal = second.position - first.position;
+    let n2 = normal.norm_squared();
+    let closing = (first.velocity - second.velocity).dot(&normal) + growth * n2.sqrt();
+    if closing <= 0.0 || n2 == 0.0 {
+        return Impulse { on_second: SVector::zeros(), normal };
+    }
+    let (m1, m2) = (first.mass, second.mass);
+    let mu = m1 * m2 / (m1 + m2);
+    let j = normal * ((1.0 + e.0) * mu * closing / n2);
+    first.velocity -= j / m1;
+    second.velocity += j / m2;
+    Impulse { on_second: j, normal }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -159,6 +200,36 @@ mod tests {
         }
         assert!(Restitution::new(1.5).is_err());
         assert!(Restitution::new(f64::NAN).is_err());
+    }
+
+    /// With growth the gap's closing speed is reversed: unequal masses, oblique, a few
+    /// restitutions; the normal relative velocity after is `G + e·(G − u)`, the tangential
+    /// components are untouched, momentum is conserved, and a gap opening faster than `G`
+    /// is left alone.
+    #[test]
+    fn growing_pairs_separate_at_least_at_the_growth_speed() {
+        let n = vector![0.6, 0.8];
+        for (e, g) in [(1.0, 0.5), (1.0, 3.0), (0.5, 0.25), (0.0, 1.0)] {
+            let mut a = body2([0.0, 0.0], [0.3, -0.2], 2.0);
+            let mut b = body2([0.6, 0.8], [-0.1, 0.4], 3.0);
+            let u = (b.velocity - a.velocity).dot(&n);
+            let (pa, pb) = (a.velocity * 2.0 + b.velocity * 3.0, (a.velocity - b.velocity).dot(&vector![0.8, -0.6]));
+            resolve_growing_pair(&mut a, &mut b, Restitution::new(e).unwrap(), g);
+            let after = (b.velocity - a.velocity).dot(&n);
+            assert!((after - (g + e * (g - u))).abs() <= 8.0 * EPS * (g + u.abs()), "e = {e}, G = {g}: {after}");
+            assert!(after >= g * (1.0 - 8.0 * EPS) || e < 1.0);
+            assert!(((a.velocity - b.velocity).dot(&vector![0.8, -0.6]) - pb).abs() <= 8.0 * EPS);
+            assert!((a.velocity * 2.0 + b.velocity * 3.0 - pa).norm() <= 16.0 * EPS);
+        }
+        // Receding at 2 > G = 1: untouched.
+        let mut a = body2([0.0, 0.0], [-1.0, 0.0], 1.0);
+        let mut b = body2([1.0, 0.0], [1.0, 0.0], 1.0);
+        assert_eq!(resolve_growing_pair(&mut a, &mut b, Restitution::ELASTIC, 1.0).virial(), 0.0);
+        // Receding at 1/2 < G = 1: pushed apart to 2G − u = 3/2.
+        let mut a = body2([0.0, 0.0], [-0.25, 0.0], 1.0);
+        let mut b = body2([1.0, 0.0], [0.25, 0.0], 1.0);
+        resolve_growing_pair(&mut a, &mut b, Restitution::ELASTIC, 1.0);
+        assert_eq!(b.velocity.x - a.velocity.x, 1.5);
     }
 
     #[test]

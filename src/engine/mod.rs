@@ -37,13 +37,15 @@ pub mod simulation;
 pub mod sources;
 pub(crate) mod timing;
 
-pub use collision::{Body, Impulse, Restitution, RestitutionError, resolve_pair};
+pub use collision::{Body, Impulse, Restitution, RestitutionError, resolve_growing_pair, resolve_pair};
 pub use geometry::{Boundary, Particle, SimBox};
+pub use motion::Radii;
 pub use neighbours::{LISTS_FROM, LISTS_FROM_3D, Neighbourhood, RANGE_HOLDS, RANGE_HOLDS_3D, UnknownNeighbourhood};
 pub use params::{EngineParams, QueueChoice, Switch};
 pub use reference::ReferenceSimulation;
 pub use setup::{OverlapAudit, SetupError, check_box};
 pub use simulation::{Simulation, SimulationState};
+pub use sources::growth::{Ending, Growth};
 pub use sources::{Event, EventCounts, EventKind, MAX_PARTICLES, Outcome};
 
 /// The engine's internals that the benchmarks time piece by piece (`benches/engine.rs`) and

@@ -17,7 +17,7 @@
 //! events.
 
 use super::geometry::{Boundary, Particle, SimBox, image_count, image_count_by_comparison};
-use super::motion;
+use super::motion::{self, Radii};
 use super::neighbours::Neighbours;
 use super::sources::pair::{self, PairBracket};
 use super::sources::{Event, EventKind};
@@ -85,6 +85,7 @@ impl<const D: usize> Search<D> {
         skip: usize,
         near: &[u32; NEAR],
         gathered: Option<usize>,
+        radii: Radii,
         best: &mut Event,
     ) {
         let owner = i as u32;
@@ -94,7 +95,7 @@ impl<const D: usize> Search<D> {
             }
         };
         let Some(n_near) = gathered else {
-            return scalar(particles, sim_box, short, neighbours, now, i, skip, best);
+            return scalar(particles, sim_box, short, neighbours, now, i, skip, radii, best);
         };
         // Pass 1: bracket the neighbours LANES at a time (branch-free); `bound` is the
         // earliest time some candidate is certain to reach. Every chunk is LANES wide (the
@@ -149,8 +150,8 @@ impl<const D: usize> Search<D> {
 }
 
 /// The search one pair at a time, for the cases the batch cannot take: short periodic axes
-/// (several images per pair) and more than [`NEAR`] neighbours (tiny disks among large
-/// ones). Same events.
+/// (several images per pair), more than [`NEAR`] neighbours (tiny disks among large
+/// ones), and growing radii. Same events.
 #[cold]
 #[allow(clippy::too_many_arguments)]
 fn scalar<const D: usize>(
@@ -161,6 +162,7 @@ fn scalar<const D: usize>(
     now: f64,
     i: usize,
     skip: usize,
+    radii: Radii,
     best: &mut Event,
 ) {
     let p = &particles[i];
@@ -180,7 +182,7 @@ fn scalar<const D: usize>(
             continue;
         }
         let q = &particles[j];
-        let exact = match pair::bracket(p, q, sim_box, now, short, bound) {
+        let exact = match pair::bracket(p, q, sim_box, now, short, bound, radii) {
             PairBracket::Beyond | PairBracket::Known(None) => continue,
             PairBracket::Known(Some(t)) => t,
             PairBracket::Between { lo, hi } if n_hits < HITS => {
@@ -190,7 +192,9 @@ fn scalar<const D: usize>(
                 continue;
             }
             // No room left to defer it: evaluate it now.
-            PairBracket::Between { .. } => pair::predict(p, q, sim_box, now, short).expect("a bracketed contact"),
+            PairBracket::Between { .. } => {
+                pair::predict(p, q, sim_box, now, short, radii).expect("a bracketed contact")
+            }
         };
         let kind = EventKind::Pair { partner: j as u32, partner_events: q.events };
         consider(best, Event { time: exact.max(now), kind });
@@ -203,7 +207,7 @@ fn scalar<const D: usize>(
         }
         let j = j as usize;
         let q = &particles[j];
-        let t = pair::predict(p, q, sim_box, now, short).expect("a bracketed contact");
+        let t = pair::predict(p, q, sim_box, now, short, radii).expect("a bracketed contact");
         let kind = EventKind::Pair { partner: j as u32, partner_events: q.events };
         consider(best, Event { time: t.max(now), kind });
     }

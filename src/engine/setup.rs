@@ -60,6 +60,11 @@ pub enum SetupError {
         /// Overlap as a fraction of their contact distance.
         fraction: f64,
     },
+    /// A growth (compression) that cannot start: a bad schedule, or one already under way.
+    Growth {
+        /// What is wrong.
+        what: String,
+    },
 }
 
 impl fmt::Display for SetupError {
@@ -95,6 +100,7 @@ impl fmt::Display for SetupError {
             SetupError::Overlap { i, j, fraction } => {
                 write!(f, "particles {i} and {j} overlap by {:.3e} of their contact distance", fraction)
             }
+            SetupError::Growth { what } => write!(f, "cannot grow the particles: {what}"),
         }
     }
 }

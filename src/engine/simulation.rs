@@ -23,11 +23,13 @@
 use super::arrays::Store;
 use super::collision::Restitution;
 use super::geometry::{Boundary, Particle, SimBox};
+use super::motion::Radii;
 use super::neighbours::{Neighbourhood, Neighbours, Saved};
 use super::params::EngineParams;
 use super::queue::{EventQueue, QueueKind};
 use super::search::{NEAR, Search};
-use super::setup::{OverlapAudit, RESTORE_OVERLAP, SetupError, validate};
+use super::setup::{OverlapAudit, RESTORE_OVERLAP, SetupError, check_box, validate};
+use super::sources::growth::{AfterCollision, Ending, Growth};
 use super::sources::sample::Sampling;
 use super::sources::{self, Event, EventCounts, EventKind, Outcome, pair, wall};
 use super::timing::{Reading, Timing};
@@ -49,6 +51,10 @@ pub struct Simulation<const D: usize> {
     restitution: Restitution,
     counts: EventCounts,
     sampling: Sampling,
+    /// A compression under way, if any.
+    growth: Option<Growth>,
+    /// How the last growth ended (none yet: `None`).
+    ending: Option<Ending>,
     search: Search<D>,
     timing: Timing,
 }
@@ -83,6 +89,9 @@ pub struct SimulationState<const D: usize> {
     pub sampling: Option<f64>,
     /// The next sampling instant, if sampling.
     pub next_sample: Option<f64>,
+    /// A compression under way (absent when none).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub growth: Option<Growth>,
 }
 
 impl<const D: usize> Simulation<D> {
@@ -131,6 +140,8 @@ impl<const D: usize> Simulation<D> {
             restitution: Restitution::ELASTIC,
             counts: EventCounts::default(),
             sampling: Sampling::default(),
+            growth: None,
+            ending: None,
             search: Search::new(batch),
             timing,
         };
@@ -139,10 +150,120 @@ impl<const D: usize> Simulation<D> {
         Ok(sim)
     }
 
+    /// Starts a compression now: every radius grows at `rate` times its present value per
+    /// unit time until `until` (Lubachevsky–Stillinger; see
+    /// [`sources::growth`](super::sources::growth)), the velocities rescaled to `kt` every
+    /// `every` pair collisions. The packing fraction at `until` is
+    /// `φ(now)·(1 + rate·(until − now))^d`.
+    ///
+    /// While the radii grow the neighbourhood is the cell grid, sized for the final radii
+    /// (the box must hold them: a periodic edge at least two final diameters, an edge
+    /// between walls longer than one), and pairs are searched one at a time with the growing
+    /// kernel. At `until` the step reports [`Outcome::GrowthEnd`] and the engine goes back to
+    /// its usual neighbourhood.
+    pub fn grow(&mut self, rate: f64, until: f64, kt: f64, every: u64) -> Result<(), SetupError> {
+        if self.growth.is_some() {
+            return Err(SetupError::Growth { what: "a growth is already under way".into() });
+        }
+        let growth =
+            Growth::new(rate, self.time, until, kt, every).map_err(|e| SetupError::Growth { what: e.to_string() })?;
+        check_box(&self.sim_box, 2.0 * growth.final_radius(&self.particles))?;
+        self.growth = Some(growth);
+        self.arrange_neighbourhood();
+        self.predict_everyone();
+        Ok(())
+    }
+
+    /// [`grow`](Self::grow) until the packing fraction reaches `target`: the growth ends at
+    /// `now + ((target/φ)^(1/d) − 1)/rate`, `φ` the packing fraction now.
+    pub fn grow_to(&mut self, target: f64, rate: f64, kt: f64, every: u64) -> Result<(), SetupError> {
+        let now = self.packing_fraction();
+        if !(target.is_finite() && target > now) {
+            return Err(SetupError::Growth {
+                what: format!("the target packing fraction {target} must exceed the present one, {now}"),
+            });
+        }
+        let until = self.time + ((target / now).powf(1.0 / D as f64) - 1.0) / rate;
+        self.grow(rate, until, kt, every)
+    }
+
+    /// The compression under way, if any.
+    pub fn growth(&self) -> Option<&Growth> {
+        self.growth.as_ref()
+    }
+
+    /// How the last growth ended, once one has (not kept in checkpoints).
+    pub fn growth_ending(&self) -> Option<Ending> {
+        self.ending
+    }
+
+    /// Ends the growth under way now ([`Ending::Stopped`]): the radii are frozen at their
+    /// present values. Nothing happens without one.
+    pub fn end_growth(&mut self) {
+        self.finish_growth(self.time, Ending::Stopped);
+    }
+
+    /// Freezes the radii at `t` (the clock) and goes back to the usual neighbourhood.
+    fn finish_growth(&mut self, t: f64, ending: Ending) {
+        let Some(growth) = self.growth.take() else { return };
+        self.time = t;
+        growth.resolve(&mut self.particles, t);
+        self.ending = Some(ending);
+        self.arrange_neighbourhood();
+        self.predict_everyone();
+    }
+
+    /// The radii as they change in time (the motion law's second half).
+    #[inline(always)]
+    pub fn radii(&self) -> Radii {
+        self.growth.as_ref().map_or(Radii::Fixed, Growth::radii)
+    }
+
+    /// Particle `i`'s radius now (its `radius` field unless a growth is under way).
+    pub fn radius(&self, i: usize) -> f64 {
+        self.radii().radius(self.particles[i].radius, self.time)
+    }
+
+    /// The packing fraction now: the particles' volume (at their present radii) over the
+    /// box's.
+    pub fn packing_fraction(&self) -> f64 {
+        let radii = self.radii();
+        let volume: f64 =
+            self.particles.iter().map(|p| super::init::ball_volume::<D>(radii.radius(p.radius, self.time))).sum();
+        volume / self.sim_box.volume()
+    }
+
+    /// The neighbourhood, the short axes and the search for the present radii: while growing
+    /// the grid sized for the final radii and the scalar search; otherwise what the
+    /// parameters ask for. The pending events must be predicted again afterwards.
+    fn arrange_neighbourhood(&mut self) {
+        let (reach, growing) = match &self.growth {
+            Some(g) => (2.0 * g.final_radius(&self.particles), true),
+            None => (2.0 * self.particles.iter().map(|p| p.radius).fold(0.0, f64::max), false),
+        };
+        self.short = pair::short_axes(&self.sim_box, reach);
+        let batch = !self.short.contains(&true) && !growing;
+        let store = self.timing.store();
+        let (sim_box, time, choice) = (&self.sim_box, self.time, self.params.neighbourhood);
+        self.neighbours = Neighbours::new(sim_box, reach, &self.particles, time, batch, choice, &store);
+        self.search = Search::new(batch);
+    }
+
     /// Restores a saved state (see [`Simulation::state`]), with the engine's automatic
     /// choices but the neighbourhood it was saved with.
     pub fn restore(state: SimulationState<D>, sim_box: SimBox<D>) -> Result<Self, SetupError> {
-        let reach = validate(&state.particles, &sim_box)?;
+        let mut reach = validate(&state.particles, &sim_box)?;
+        if let Some(g) = &state.growth {
+            let fine = Growth::new(g.rate, g.origin, g.until, g.kt, g.every).is_ok()
+                && g.origin <= state.time
+                && state.time <= g.until
+                && state.centres.is_empty();
+            if !fine {
+                return Err(SetupError::BadState { what: format!("growth {g:?} with the clock at {}", state.time) });
+            }
+            reach = 2.0 * g.final_radius(&state.particles);
+            check_box(&sim_box, reach)?;
+        }
         let n = state.particles.len();
         let bad = |what: String| Err(SetupError::BadState { what });
         if state.cells.iter().any(|c| c.len() != D) || state.centres.iter().any(|c| c.len() != D) {
@@ -183,7 +304,7 @@ impl<const D: usize> Simulation<D> {
             Saved::Centres(state.centres.iter().map(|c| SVector::from_column_slice(c)).collect(), state.crowded)
         };
         let short = pair::short_axes(&sim_box, reach);
-        let batch = !short.contains(&true);
+        let batch = !short.contains(&true) && state.growth.is_none();
         let params = EngineParams::with_neighbourhood(state.neighbourhood);
         let timing = Timing::new(&params, n);
         let store = timing.store();
@@ -217,6 +338,8 @@ impl<const D: usize> Simulation<D> {
             restitution: Restitution::ELASTIC,
             counts: state.counts,
             sampling,
+            growth: state.growth,
+            ending: None,
         };
         sim.refuse_overlaps(RESTORE_OVERLAP)?;
         sim.check_pending().map_err(|what| SetupError::BadState { what })?;
@@ -232,18 +355,19 @@ impl<const D: usize> Simulation<D> {
     /// apart.
     fn check_pending(&self) -> Result<(), String> {
         let now = self.time;
+        let radii = self.radii();
         // An update's time depends on the clock it was predicted at, by rounding; the exit
         // radius is 2⁻²⁰ of the skin inside it, far more than this.
         let close = |a: f64, b: f64| (a - b).abs() <= 1e-12 * a.abs().max(b.abs()).max(1.0);
         for i in 0..self.particles.len() {
             let p = &self.particles[i];
             let e = self.queue.get(i);
-            let wall = wall::predict(p, &self.sim_box).map(|(t, axis, upper)| (t.max(now), axis, upper));
+            let wall = wall::predict(p, &self.sim_box, radii).map(|(t, axis, upper)| (t.max(now), axis, upper));
             let exit = sources::neighbourhood::predict(&self.neighbours, i, p, now).map(|t| t.max(now));
             let fine = match e.kind {
                 EventKind::Pair { partner, .. } if e.is_live(&self.particles) => {
                     let q = &self.particles[partner as usize];
-                    pair::predict(p, q, &self.sim_box, now, &self.short).map(|t| t.max(now)) == Some(e.time)
+                    pair::predict(p, q, &self.sim_box, now, &self.short, radii).map(|t| t.max(now)) == Some(e.time)
                 }
                 EventKind::Wall { axis, upper } => wall == Some((e.time, axis as usize, upper)),
                 EventKind::Rebuild => exit.is_some_and(|x| close(x, e.time)),
@@ -262,7 +386,7 @@ impl<const D: usize> Simulation<D> {
             }
             for j in self.neighbours.candidates(i).filter(|&j| j > i) {
                 let q = &self.particles[j];
-                if let Some(t) = pair::predict(p, q, &self.sim_box, now, &self.short).map(|t| t.max(now))
+                if let Some(t) = pair::predict(p, q, &self.sim_box, now, &self.short, radii).map(|t| t.max(now))
                     && e.time.min(self.queue.get(j).time) > t
                 {
                     return Err(format!(
@@ -293,6 +417,7 @@ impl<const D: usize> Simulation<D> {
             counts: self.counts,
             sampling: self.sampling.interval,
             next_sample: self.sampling.next,
+            growth: self.growth,
         }
     }
 
@@ -388,6 +513,42 @@ impl<const D: usize> Simulation<D> {
             .collect()
     }
 
+    /// Every pair whose gap `|rⱼ − rᵢ| − (Rᵢ + Rⱼ)` (minimum image, present radii) is at most
+    /// `tolerance` times its contact distance, as `(i, j, gap / contact distance)` with
+    /// `i < j`, in increasing order of `i` then of `j`'s place among `i`'s neighbours; and
+    /// every particle within `tolerance` of its own diameter of a wall, as `(i, axis, upper,
+    /// gap / diameter)`. For contact networks (`observe::contacts`); `tolerance` must be small
+    /// enough that such pairs are neighbours (below about 1).
+    #[allow(clippy::type_complexity)]
+    pub fn near_contacts(&self, tolerance: f64) -> (Vec<(usize, usize, f64)>, Vec<(usize, usize, bool, f64)>) {
+        let (t, radii) = (self.time, self.radii());
+        let (mut pairs, mut walls) = (Vec::new(), Vec::new());
+        for (i, p) in self.particles.iter().enumerate() {
+            let ri = radii.radius(p.radius, t);
+            for j in self.neighbours.candidates(i).filter(|&j| j > i) {
+                let q = &self.particles[j];
+                let (a, b) = pair::positions(p, q, &self.sim_box, t);
+                let sigma = ri + radii.radius(q.radius, t);
+                let gap = ((b - a).norm() - sigma) / sigma;
+                if gap <= tolerance {
+                    pairs.push((i, j, gap));
+                }
+            }
+            let r = p.position_at(t);
+            for a in 0..D {
+                if self.sim_box.boundary[a] == Boundary::Wall {
+                    for (upper, gap) in [(false, r[a] - ri), (true, self.sim_box.lengths[a] - ri - r[a])] {
+                        if gap / (2.0 * ri) <= tolerance {
+                            walls.push((i, a, upper, gap / (2.0 * ri)));
+                        }
+                    }
+                }
+            }
+        }
+        pairs.sort_by_key(|&(i, j, _)| (i, j));
+        (pairs, walls)
+    }
+
     /// Audits the current state: the largest overlap between two particles (as a fraction of
     /// their contact distance) or of a particle beyond a wall (as a fraction of its diameter).
     pub fn check_overlaps(&self) -> OverlapAudit {
@@ -404,10 +565,10 @@ impl<const D: usize> Simulation<D> {
         }
         let p = &self.particles[i];
         let r = p.position_at(self.time);
+        let radius = self.radius(i);
         let axis = (0..D)
             .find(|&a| {
-                self.sim_box.boundary[a] == Boundary::Wall
-                    && (r[a] < p.radius || r[a] > self.sim_box.lengths[a] - p.radius)
+                self.sim_box.boundary[a] == Boundary::Wall && (r[a] < radius || r[a] > self.sim_box.lengths[a] - radius)
             })
             .unwrap_or(0);
         Err(SetupError::OutsideBox { index: i, axis, coordinate: r[axis] })
@@ -417,21 +578,23 @@ impl<const D: usize> Simulation<D> {
     fn overlap_beyond(&self, threshold: f64) -> Option<OverlapAudit> {
         let mut worst = OverlapAudit { fraction: threshold.max(0.0), at: None };
         let t = self.time;
+        let radius = |p: &Particle<D>| self.radii().radius(p.radius, t);
         for (i, p) in self.particles.iter().enumerate() {
             for j in self.neighbours.candidates(i).filter(|&j| j > i) {
                 let q = &self.particles[j];
                 let (ri, rj) = pair::positions(p, q, &self.sim_box, t);
-                let sigma = p.radius + q.radius;
+                let sigma = radius(p) + radius(q);
                 let fraction = (sigma - (rj - ri).norm()) / sigma;
                 if fraction > worst.fraction {
                     worst = OverlapAudit { fraction, at: Some((i, j)) };
                 }
             }
             let r = p.position_at(t);
+            let radius = radius(p);
             for a in 0..D {
                 if self.sim_box.boundary[a] == Boundary::Wall {
-                    let beyond = (p.radius - r[a]).max(r[a] - (self.sim_box.lengths[a] - p.radius));
-                    let fraction = beyond / (2.0 * p.radius);
+                    let beyond = (radius - r[a]).max(r[a] - (self.sim_box.lengths[a] - radius));
+                    let fraction = beyond / (2.0 * radius);
                     if fraction > worst.fraction {
                         worst = OverlapAudit { fraction, at: Some((i, i)) };
                     }
@@ -451,13 +614,20 @@ impl<const D: usize> Simulation<D> {
     pub fn step(&mut self) -> Option<Outcome<D>> {
         loop {
             let (owner, next) = self.queue.first();
+            let end = self.growth.map(|g| Event { time: g.predict(), kind: EventKind::GrowthEnd });
+            let ends_first = end.is_some_and(|end| end.before(u32::MAX, &next, owner as u32));
             if let Some(time) = self.sampling.predict()
                 && (Event { time, kind: EventKind::Sample }).before(u32::MAX, &next, owner as u32)
+                && end.is_none_or(|end| (Event { time, kind: EventKind::Sample }).before(u32::MAX, &end, u32::MAX))
             {
                 self.time = time;
                 self.sampling.resolve(time);
                 self.counts.record(&Outcome::<D>::Sample);
                 return Some(Outcome::Sample);
+            }
+            if ends_first && let Some(growth) = &self.growth {
+                self.finish_growth(growth.predict(), Ending::Reached);
+                return Some(Outcome::GrowthEnd);
             }
             if next.kind == EventKind::Nothing {
                 return None;
@@ -473,16 +643,25 @@ impl<const D: usize> Simulation<D> {
             self.time = next.time;
             let (Some(a), b) = next.involved(owner) else { unreachable!("an event of a particle") };
             let guess = self.timing.begin(&self.reading(), a, b);
+            let radii = self.radii();
             let outcome = sources::resolve(
                 &mut self.particles,
                 &self.sim_box,
                 Some(&mut self.neighbours),
                 self.restitution,
+                radii,
                 owner,
                 &next,
             );
             self.counts.record(&outcome);
-            if self.wrapped(&outcome) {
+            let dof = self.degrees_of_freedom();
+            let after = match (&mut self.growth, &outcome) {
+                (Some(growth), Outcome::Pair { .. }) => growth.after_collision(&mut self.particles, next.time, dof),
+                _ => AfterCollision::Counted,
+            };
+            if after == AfterCollision::Stalled {
+                self.finish_growth(next.time, Ending::Stalled);
+            } else if after == AfterCollision::Rescaled || self.wrapped(&outcome) {
                 self.predict_everyone();
             } else if let Some(b) = b {
                 self.predict_partners(a, b, guess);
@@ -515,8 +694,9 @@ impl<const D: usize> Simulation<D> {
         let p = &self.particles[i];
         let now = self.time;
         let owner = i as u32;
+        let radii = self.radii();
         let mut best = Event::NOTHING;
-        sources::predict_alone(p, i, &self.sim_box, Some(&self.neighbours), now, |e| {
+        sources::predict_alone(p, i, &self.sim_box, Some(&self.neighbours), now, radii, |e| {
             if e.before(owner, &best, owner) {
                 best = e;
             }
@@ -532,6 +712,7 @@ impl<const D: usize> Simulation<D> {
             skip,
             near,
             gathered,
+            radii,
             &mut best,
         );
         self.queue.set(i, best);

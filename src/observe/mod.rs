@@ -10,6 +10,8 @@
 //!   series (every run has it; its estimators are specified in [`thermo`]).
 //! * The registered observables a configuration names under `[observe.<name>]`
 //!   ([`Selection`]): [`velocities`] (the velocity distribution against the Maxwellian).
+//! * [`contacts`]: the contact network of a dense state (contacts per particle, rattlers),
+//!   an analysis of one state rather than an observer of events.
 //!   A run keeps them in its checkpoints and reports them in `summary.json`
 //!   (`"observables"`); an experiment can also build any observer itself and hand it to
 //!   [`Run::advance`](crate::run::Run::advance).
@@ -21,6 +23,7 @@
 //! [`Selection`], its variant of [`Observable`], and its line in each match below.
 
 pub mod blocks;
+pub mod contacts;
 pub mod thermo;
 pub mod velocities;
 

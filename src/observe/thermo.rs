@@ -155,7 +155,9 @@ impl<const D: usize> Observer<D> for Thermo {
                 self.interval = Totals { wall_impulse: vec![[0.0; 2]; D], ..Totals::default() };
                 self.interval_start = now;
             }
-            Outcome::Rebuild { .. } => {}
+            // Bookkeeping; the end of a growth moves no momentum across the walls or between
+            // particles (the radii stop growing).
+            Outcome::Rebuild { .. } | Outcome::GrowthEnd => {}
         }
     }
 }

@@ -75,7 +75,7 @@ impl Calendar {
 
     /// A queue of `n` particles with nothing pending.
     pub fn nothing(n: usize) -> Self {
-        assert!((1..=MAX_PARTICLES).contains(&n), "1 ≤ n ≤ 2³² − 5 particles");
+        assert!((1..=MAX_PARTICLES).contains(&n), "1 ≤ n ≤ 2³² − 6 particles");
         let buckets = n.next_power_of_two();
         Calendar {
             slots: vec![Slot::pack(Event::NOTHING); n],

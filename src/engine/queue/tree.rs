@@ -99,7 +99,7 @@ impl Tree {
     /// A queue of `n` particles with nothing pending (no temporary list of events: at
     /// N = 10⁶ one cost 24 MB of peak memory).
     pub(crate) fn nothing(n: usize, store: &impl Store) -> Self {
-        assert!(n >= 1 && n <= MAX_PARTICLES, "1 ≤ n ≤ 2³² − 5 particles");
+        assert!(n >= 1 && n <= MAX_PARTICLES, "1 ≤ n ≤ 2³² − 6 particles");
         let mut slots = n;
         while (slots - 1) % (ARITY - 1) != 0 {
             slots += 1;

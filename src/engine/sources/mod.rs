@@ -9,6 +9,7 @@
 //! | hard walls | [`wall`] | when a particle reaches a wall | the normal velocity reversed |
 //! | the neighbourhood | [`neighbourhood`] | when a particle leaves its cell or skin | its cell or list brought up to date |
 //! | sampling | [`sample`] | the next sampling instant (global) | the clock moves there |
+//! | growth (compression) | [`growth`] | the end of the growth (global) | the radii frozen at their grown values |
 //!
 //! The [`Simulation`](super::Simulation) keeps one pending event per particle — the earliest
 //! of every source's prediction for it — and a global one for sampling; the
@@ -18,7 +19,8 @@
 //!
 //! # The total order
 //!
-//! By time; at equal times by source (pair < wall < neighbourhood < sample < nothing); then
+//! By time; at equal times by source (pair < wall < neighbourhood < sample < end of growth <
+//! nothing); then
 //! by the particles and axes involved (lower particle first, then partner, or axis and
 //! direction). No two distinct live events compare equal, so which event comes next never
 //! depends on how the events were stored or reached — and the fast engine and the reference
@@ -58,6 +60,7 @@
 //! exhaustive on purpose: the compiler asks how the new source's momentum enters the
 //! pressure (nothing, for a source that exchanges none with the outside).
 
+pub mod growth;
 pub mod neighbourhood;
 pub mod pair;
 pub mod sample;
@@ -65,14 +68,15 @@ pub mod wall;
 
 use super::collision::{Impulse, Restitution};
 use super::geometry::{Boundary, Particle, SimBox};
+use super::motion::Radii;
 use super::neighbours::Neighbours;
 use serde::{Deserialize, Serialize};
 use std::fmt;
 
 /// The most particles an engine takes: indices are 32-bit, the words at and above
-/// `u32::MAX − 3` are the tags of the queue's slot words, and the tournament tree pads the
+/// `u32::MAX − 4` are the tags of the queue's slot words, and the tournament tree pads the
 /// particles with up to two empty slots.
-pub const MAX_PARTICLES: usize = u32::MAX as usize - 4;
+pub const MAX_PARTICLES: usize = u32::MAX as usize - 5;
 
 /// A predicted event of one particle (its *owner*: the engine's queue holds one per
 /// particle, the reference keeps the owner beside it), or a global one.
@@ -116,6 +120,8 @@ pub enum EventKind {
     Rebuild,
     /// A sampling instant (global: no owner).
     Sample,
+    /// The end of a growth (global: no owner).
+    GrowthEnd,
     /// Nothing will ever happen to the owner (it is at rest and alone).
     Nothing,
 }
@@ -129,6 +135,7 @@ const NOTHING_TAG: u32 = u32::MAX;
 const WALL_TAG: u32 = u32::MAX - 1;
 const REBUILD_TAG: u32 = u32::MAX - 2;
 const SAMPLE_TAG: u32 = u32::MAX - 3;
+const GROWTH_END_TAG: u32 = u32::MAX - 4;
 
 impl EventKind {
     /// Its place among simultaneous events (the variant's order).
@@ -139,7 +146,8 @@ impl EventKind {
             EventKind::Wall { .. } => 1,
             EventKind::Rebuild => 2,
             EventKind::Sample => 3,
-            EventKind::Nothing => 4,
+            EventKind::GrowthEnd => 4,
+            EventKind::Nothing => 5,
         }
     }
 
@@ -156,6 +164,7 @@ impl EventKind {
             EventKind::Wall { axis, upper } => (WALL_TAG, axis as u32 | (upper as u32) << 8),
             EventKind::Rebuild => (REBUILD_TAG, 0),
             EventKind::Sample => (SAMPLE_TAG, 0),
+            EventKind::GrowthEnd => (GROWTH_END_TAG, 0),
             EventKind::Nothing => (NOTHING_TAG, 0),
         }
     }
@@ -168,6 +177,7 @@ impl EventKind {
             WALL_TAG => EventKind::Wall { axis: what as u8, upper: what >> 8 != 0 },
             REBUILD_TAG => EventKind::Rebuild,
             SAMPLE_TAG => EventKind::Sample,
+            GROWTH_END_TAG => EventKind::GrowthEnd,
             partner => EventKind::Pair { partner, partner_events: what },
         }
     }
@@ -185,7 +195,7 @@ impl Event {
         match self.kind {
             EventKind::Pair { partner, .. } => (rank, owner.min(partner), owner.max(partner), 0),
             EventKind::Wall { axis, upper } => (rank, owner, axis as u32, upper as u8),
-            EventKind::Sample => (rank, GLOBAL, 0, 0),
+            EventKind::Sample | EventKind::GrowthEnd => (rank, GLOBAL, 0, 0),
             EventKind::Rebuild | EventKind::Nothing => (rank, owner, 0, 0),
         }
     }
@@ -217,7 +227,7 @@ impl Event {
                 (Some(owner.min(partner)), Some(owner.max(partner)))
             }
             EventKind::Wall { .. } | EventKind::Rebuild => (Some(owner), None),
-            EventKind::Sample | EventKind::Nothing => (None, None),
+            EventKind::Sample | EventKind::GrowthEnd | EventKind::Nothing => (None, None),
         }
     }
 }
@@ -231,7 +241,7 @@ impl EventKind {
             EventKind::Pair { partner, .. } => (partner as usize) < n && partner as usize != owner,
             EventKind::Wall { axis, .. } => (axis as usize) < D && sim_box.boundary[axis as usize] == Boundary::Wall,
             EventKind::Rebuild | EventKind::Nothing => true,
-            EventKind::Sample => false,
+            EventKind::Sample | EventKind::GrowthEnd => false,
         }
     }
 }
@@ -267,6 +277,9 @@ pub enum Outcome<const D: usize> {
     },
     /// A scheduled sampling time was reached.
     Sample,
+    /// A growth ended: every radius is now fixed at its grown value (every particle was
+    /// advanced to this time; no momentum changed).
+    GrowthEnd,
 }
 
 impl<const D: usize> Outcome<D> {
@@ -279,7 +292,7 @@ impl<const D: usize> Outcome<D> {
         match *self {
             Outcome::Pair { i, j, .. } => Some((i, j)),
             Outcome::Wall { i, .. } => Some((i, i)),
-            Outcome::Rebuild { .. } | Outcome::Sample => None,
+            Outcome::Rebuild { .. } | Outcome::Sample | Outcome::GrowthEnd => None,
         }
     }
 }
@@ -296,6 +309,7 @@ impl<const D: usize> fmt::Display for Outcome<D> {
             ),
             Outcome::Rebuild { i } => write!(f, "a neighbourhood update of particle {i}"),
             Outcome::Sample => write!(f, "a sample"),
+            Outcome::GrowthEnd => write!(f, "the end of the growth"),
         }
     }
 }
@@ -326,6 +340,8 @@ impl EventCounts {
             Outcome::Wall { .. } => self.wall += 1,
             Outcome::Rebuild { .. } => self.rebuild += 1,
             Outcome::Sample => self.sample += 1,
+            // Once per growth: the summary reports growth apart.
+            Outcome::GrowthEnd => {}
         }
     }
 
@@ -366,9 +382,10 @@ pub(crate) fn predict_alone<const D: usize>(
     sim_box: &SimBox<D>,
     neighbours: Option<&Neighbours<D>>,
     now: f64,
+    radii: Radii,
     mut consider: impl FnMut(Event),
 ) {
-    if let Some((t, axis, upper)) = wall::predict(p, sim_box) {
+    if let Some((t, axis, upper)) = wall::predict(p, sim_box, radii) {
         consider(Event { time: t.max(now), kind: EventKind::Wall { axis: axis as u8, upper } });
     }
     if let Some(t) = neighbours.and_then(|n| neighbourhood::predict(n, i, p, now)) {
@@ -384,6 +401,7 @@ pub(crate) fn resolve<const D: usize>(
     sim_box: &SimBox<D>,
     neighbours: Option<&mut Neighbours<D>>,
     restitution: Restitution,
+    radii: Radii,
     owner: usize,
     event: &Event,
 ) -> Outcome<D> {
@@ -391,12 +409,12 @@ pub(crate) fn resolve<const D: usize>(
     match event.kind {
         EventKind::Pair { partner, .. } => {
             let (i, j) = (owner.min(partner as usize), owner.max(partner as usize));
-            let impulse = pair::resolve(particles, i, j, sim_box, t, restitution);
+            let impulse = pair::resolve(particles, i, j, sim_box, t, restitution, radii);
             Outcome::Pair { i, j, impulse }
         }
         EventKind::Wall { axis, upper } => {
             let axis = axis as usize;
-            let impulse = wall::resolve(&mut particles[owner], axis, upper, t);
+            let impulse = wall::resolve(&mut particles[owner], axis, upper, t, radii);
             Outcome::Wall { i: owner, axis, upper, impulse }
         }
         EventKind::Rebuild => {
@@ -404,7 +422,7 @@ pub(crate) fn resolve<const D: usize>(
             neighbourhood::resolve(neighbours, owner, &particles[owner], t);
             Outcome::Rebuild { i: owner }
         }
-        EventKind::Sample | EventKind::Nothing => unreachable!("not an event of a particle"),
+        EventKind::Sample | EventKind::GrowthEnd | EventKind::Nothing => unreachable!("not an event of a particle"),
     }
 }
 
@@ -448,6 +466,7 @@ mod tests {
         assert_eq!(Outcome::<2>::Wall { i: 5, axis: 1, upper: false, impulse: 1.0 }.collided(), Some((5, 5)));
         assert_eq!(Outcome::<2>::Rebuild { i: 5 }.collided(), None);
         assert_eq!(Outcome::<2>::Sample.collided(), None);
+        assert_eq!(Outcome::<2>::GrowthEnd.collided(), None);
     }
 
     /// A restored pending event must be one the particle can have.
@@ -471,7 +490,7 @@ mod tests {
     #[test]
     fn every_kind_survives_its_packing() {
         let largest = MAX_PARTICLES as u32 - 1;
-        let mut kinds = vec![EventKind::Nothing, EventKind::Rebuild, EventKind::Sample];
+        let mut kinds = vec![EventKind::Nothing, EventKind::Rebuild, EventKind::Sample, EventKind::GrowthEnd];
         for axis in [0u8, 1, 2] {
             for upper in [false, true] {
                 kinds.push(EventKind::Wall { axis, upper });
@@ -497,8 +516,9 @@ mod tests {
         let wall = at(EventKind::Wall { axis: 0, upper: false });
         let rebuild = at(EventKind::Rebuild);
         let sample = at(EventKind::Sample);
+        let end = at(EventKind::GrowthEnd);
         let nothing = Event { time: 1.0, kind: EventKind::Nothing };
-        let chain = [(pair, 7), (wall, 0), (rebuild, 0), (sample, 0), (nothing, 0)];
+        let chain = [(pair, 7), (wall, 0), (rebuild, 0), (sample, 0), (end, 0), (nothing, 0)];
         for w in chain.windows(2) {
             assert!(w[0].0.before(w[0].1, &w[1].0, w[1].1), "{:?} before {:?}", w[0], w[1]);
             assert!(!w[1].0.before(w[1].1, &w[0].0, w[0].1));
