@@ -212,3 +212,40 @@ fn a_growth_that_cannot_start_is_refused_with_the_reason() {
     sim.grow_to(0.4, 0.1, 1.0, 10).unwrap();
     assert!(message(sim.grow_to(0.5, 0.1, 1.0, 10)).contains("already under way"));
 }
+
+/// Compressed until the clock stalls, a 50:50 mixture of disks with diameter ratio 1.4
+/// jams near φ_J ≈ 0.84 (O'Hern, Silbert, Liu & Nagel, PRE 68, 011306 (2003): 0.84 for
+/// N → ∞; small N and fast compressions spread it by about ±0.02, hence the window), with no
+/// overlap beyond rounding. Its contact network, once the rattlers are removed, is stable
+/// over six decades of tolerance (10⁻¹²…10⁻⁶: the gaps of contacts and of non-contacts are
+/// that far apart), and it is not hyperstatic: a generic frictionless packing has at most
+/// `2d` contacts per particle (less `2/N′` for the free translations of a periodic box).
+/// (Measured at this seed: φ_J = 0.8438, z = 3.80 — a stalled compression's backbone is
+/// slightly hypostatic; the isostatic value itself is the jamming experiment's check, after
+/// compressing to a reduced-pressure limit.)
+#[test]
+fn a_bidisperse_packing_jams_near_the_known_density() {
+    let (particles, sim_box) = system(&two(200, 1.4), 0.5, [Boundary::Periodic; 2], 8);
+    let mut sim = Simulation::new(particles, sim_box).unwrap();
+    sim.grow_to(0.9, 0.01, 1.0, 200).unwrap();
+    while sim.growth().is_some() {
+        sim.step().expect("an event");
+    }
+    assert_eq!(sim.growth_ending(), Some(Ending::Stalled));
+    let phi = sim.packing_fraction();
+    assert!((0.82..0.86).contains(&phi), "φ_J = {phi}");
+    assert!(sim.check_overlaps().fraction <= 1e-12, "{:?}", sim.check_overlaps());
+    let tight = collide::observe::contacts::contacts(&sim, 1e-12);
+    let loose = collide::observe::contacts::contacts(&sim, 1e-6);
+    assert_eq!(tight.rattlers, loose.rattlers);
+    assert!(
+        loose.held_contacts - tight.held_contacts <= 2,
+        "{} and {} contacts",
+        tight.held_contacts,
+        loose.held_contacts
+    );
+    let held = (200 - tight.rattlers.len()) as f64;
+    let isostatic = 4.0 * (1.0 - 1.0 / held) + 2.0 / held;
+    assert!(tight.contacts_per_particle <= isostatic + 1e-9, "z = {}", tight.contacts_per_particle);
+    assert!(tight.contacts_per_particle > 3.5 && tight.rattlers.len() < 40, "{tight:?}");
+}

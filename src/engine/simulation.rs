@@ -152,7 +152,7 @@ impl<const D: usize> Simulation<D> {
 
     /// Starts a compression now: every radius grows at `rate` times its present value per
     /// unit time until `until` (Lubachevsky–Stillinger; see
-    /// [`sources::growth`](super::sources::growth)), the velocities rescaled to `kt` every
+    /// [`sources::growth`]), the velocities rescaled to `kt` every
     /// `every` pair collisions. The packing fraction at `until` is
     /// `φ(now)·(1 + rate·(until − now))^d`.
     ///
