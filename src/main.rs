@@ -427,7 +427,11 @@ fn run_simulation(args: RunArgs) -> Result<ExitCode> {
             // A new phase starts its bar (and its estimate) from zero.
             shown = Some(phase);
             bar.reset();
-            bar.set_prefix(if phase == Phase::Production { "running" } else { "equilibrating" });
+            bar.set_prefix(match phase {
+                Phase::Compression => "compressing",
+                Phase::Equilibration => "equilibrating",
+                Phase::Production => "running",
+            });
         }
         bar.set_position((done.clamp(0.0, 1.0) * 1000.0) as u64);
     };
@@ -495,6 +499,29 @@ fn run_simulation(args: RunArgs) -> Result<ExitCode> {
             return Ok(ExitCode::FAILURE);
         }
         _ => {}
+    }
+    if let Some(c) = &summary.compression {
+        let jammed = match (c.contacts_per_particle, c.rattlers) {
+            (Some(z), Some(r)) => format!("; jammed: {z:.4} contacts per particle without its {r} rattlers"),
+            _ if c.jammed => "; jammed".to_string(),
+            _ => String::new(),
+        };
+        say!(
+            "compressed to φ = {:.6} in {} collisions (t = {:.6}); Z = {:.4e}; max overlap {:.2e}{jammed}",
+            c.packing_fraction,
+            c.collisions,
+            c.sim_time,
+            c.reduced_pressure.unwrap_or(f64::NAN),
+            c.max_overlap
+        );
+        if summary.status == Status::Jammed {
+            eprintln!("collide: {source}: the packing jammed before its target packing fraction; results in {out}");
+            return Ok(ExitCode::FAILURE);
+        }
+        if summary.config.compress.as_ref().is_some_and(|c| c.to_jamming()) {
+            say!("results in {out}");
+            return Ok(ExitCode::SUCCESS);
+        }
     }
     say!(
         "{} collisions in {:.2} s ({:.3} M/s); kT = {:.6}; P = {:.6} ± {:.6}; Z = {:.5} ± {:.5}; max overlap {:.2e}; energy drift {:.2e}",

@@ -8,7 +8,7 @@ use collide::run::output::xyz_frame;
 use collide::run::{Checkpoint, Config, Discard, Run, RunError, Summary};
 
 mod common;
-use common::assert_same_collisions;
+use common::{assert_same_collisions, reproducible};
 
 const EPS: f64 = f64::EPSILON;
 
@@ -22,10 +22,6 @@ fn spheres(n: usize, eta: f64, boundary: &str, collisions: u64, seed: u64) -> Co
         n - n / 2
     );
     Config::parse(&text, "spheres").unwrap()
-}
-
-fn reproducible(summary: Summary) -> Summary {
-    Summary { wall_time_s: 0.0, collisions_per_second: 0.0, ..summary }
 }
 
 /// A mixture of spheres in a box periodic along x and y and walled along z: energy and the

@@ -99,18 +99,7 @@ impl<const D: usize> Impulse<D> {
 /// assert_eq!(j.virial(), 3.0); // σ·|Δp| = 1 · 3
 /// ```
 pub fn resolve_pair<const D: usize>(first: &mut Body<D>, second: &mut Body<D>, e: Restitution) -> Impulse<D> {
-    let normal = second.position - first.position;
-    let approach = (first.velocity - second.velocity).dot(&normal);
-    let n2 = normal.norm_squared();
-    if approach <= 0.0 || n2 == 0.0 {
-        return Impulse { on_second: SVector::zeros(), normal };
-    }
-    let (m1, m2) = (first.mass, second.mass);
-    let mu = m1 * m2 / (m1 + m2);
-    let j = normal * ((1.0 + e.0) * mu * approach / n2);
-    first.velocity -= j / m1;
-    second.velocity += j / m2;
-    Impulse { on_second: j, normal }
+    resolve_growing_pair(first, second, e, 0.0)
 }
 
 /// [`resolve_pair`] for bodies whose contact distance grows at `growth` (the sum of the two
@@ -142,7 +131,9 @@ pub fn resolve_growing_pair<const D: usize>(
 ) -> Impulse<D> {
     let normal = second.position - first.position;
     let n2 = normal.norm_squared();
-    let closing = (first.velocity - second.velocity).dot(&normal) + growth * n2.sqrt();
+    let approach = (first.velocity - second.velocity).dot(&normal);
+    // Without growth the approach itself, bit for bit (and no square root).
+    let closing = if growth == 0.0 { approach } else { approach + growth * n2.sqrt() };
     if closing <= 0.0 || n2 == 0.0 {
         return Impulse { on_second: SVector::zeros(), normal };
     }

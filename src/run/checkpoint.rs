@@ -47,6 +47,9 @@ pub struct Saved<const D: usize> {
     pub observables: Vec<Observable>,
     /// The equilibration that preceded production (zero until it is over).
     pub equilibration: Equilibration,
+    /// The compression, with `[compress]` (absent without).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub compression: Option<super::Compression>,
     /// Event counts when production started.
     pub start_counts: EventCounts,
     /// Wall-clock seconds of production so far, over every process that ran it.

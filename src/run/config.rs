@@ -61,10 +61,15 @@ pub struct Config {
     /// The initial state.
     #[serde(default)]
     pub init: InitConfig,
+    /// Compression from the initial state before equilibration (`[compress]`; absent: none).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub compress: Option<CompressConfig>,
     /// Equilibration before measuring.
     #[serde(default)]
     pub equilibration: Length,
-    /// The measured (production) run.
+    /// The measured (production) run (absent only with `compress.until = "jammed"`, where
+    /// the run ends at the jammed packing).
+    #[serde(default)]
     pub run: RunConfig,
     /// Optional outputs.
     #[serde(default)]
@@ -204,6 +209,69 @@ pub struct Length {
     pub time: Option<f64>,
 }
 
+/// `[compress]`: a Lubachevsky–Stillinger compression from the initial state — every radius
+/// grows in proportion, `dRᵢ/dt = rate·Rᵢ(0)`, the velocities rescaled to `init.kT` every
+/// `thermostat_every` pair collisions — to a packing fraction (the run then equilibrates and
+/// measures there) or until the packing jams (the run ends there).
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct CompressConfig {
+    /// Relative growth rate per unit time (> 0).
+    pub rate: f64,
+    /// The packing fraction to compress to.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub target_packing_fraction: Option<f64>,
+    /// `"jammed"`: compress until the packing jams.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub until: Option<Until>,
+    /// With `until = "jammed"`: the reduced pressure `Z = PV/(NkT)` at which the packing
+    /// counts as jammed (default [`PRESSURE_LIMIT`]).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub pressure_limit: Option<f64>,
+    /// Pair collisions between rescalings of the velocities (default: the number of
+    /// particles).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub thermostat_every: Option<u64>,
+    /// With `until = "jammed"`: the gap, as a fraction of the contact distance, within which
+    /// two particles (or a particle and a wall) count as in contact (default: see
+    /// [`CompressConfig::contact_tolerance`]).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub contact_tolerance: Option<f64>,
+}
+
+/// Where a compression stops, when not at a packing fraction.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum Until {
+    /// When the packing jams: its reduced pressure reaches `pressure_limit`, or its clock
+    /// stalls.
+    Jammed,
+}
+
+/// The default reduced-pressure limit of a compression to jamming: `Z = 10¹²`, where the
+/// gaps of the contacts are some `d·φ/Z ≈ 10⁻¹²` diameters — a thousand times below the
+/// default contact tolerance and still some thousand ulps of a diameter.
+pub const PRESSURE_LIMIT: f64 = 1e12;
+
+impl CompressConfig {
+    /// Whether the compression runs until the packing jams.
+    pub fn to_jamming(&self) -> bool {
+        self.until == Some(Until::Jammed)
+    }
+
+    /// The reduced pressure at which the packing counts as jammed.
+    pub fn pressure_limit(&self) -> f64 {
+        self.pressure_limit.unwrap_or(PRESSURE_LIMIT)
+    }
+
+    /// The contact tolerance: the one given, or `1000·d/Z_limit` (at most 10⁻³) — a thousand
+    /// times the free-volume gap of a contact at the pressure limit, `d·φ/Z` (`10⁻⁹` at the
+    /// default limit, in 3D), and far below the gaps of particles not in contact.
+    pub fn contact_tolerance(&self, d: usize) -> f64 {
+        self.contact_tolerance.unwrap_or((1000.0 * d as f64 / self.pressure_limit()).min(1e-3))
+    }
+}
+
 /// The production run.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
@@ -218,6 +286,12 @@ pub struct RunConfig {
     /// Blocks for the error bars.
     #[serde(default = "default_blocks")]
     pub blocks: usize,
+}
+
+impl Default for RunConfig {
+    fn default() -> Self {
+        RunConfig { collisions: None, time: None, sample_interval: default_sample_interval(), blocks: default_blocks() }
+    }
 }
 
 fn default_sample_interval() -> f64 {
@@ -452,6 +526,98 @@ impl Config {
         self.init.placement.unwrap_or(if self.dimension == 3 { Placement::Fcc } else { Placement::Triangular })
     }
 
+    /// The packing fraction of the initial state: `box.packing_fraction`, or the species'
+    /// volume over the box's.
+    pub fn initial_packing_fraction(&self, d: usize) -> f64 {
+        match (self.sim_box.packing_fraction, &self.sim_box.size) {
+            (Some(eta), _) => eta,
+            (None, Some(size)) => {
+                let volume: f64 = size.iter().product();
+                let unit = if d == 3 { 4.0 / 3.0 * std::f64::consts::PI } else { std::f64::consts::PI };
+                self.species.iter().map(|s| s.count as f64 * unit * s.radius.powi(d as i32)).sum::<f64>() / volume
+            }
+            (None, None) => f64::NAN,
+        }
+    }
+
+    /// Validates `[compress]` (if any) for a run in `d` dimensions.
+    fn check_compress(&self, d: usize) -> Result<(), Invalid> {
+        let Some(c) = &self.compress else { return Ok(()) };
+        if !(c.rate.is_finite() && c.rate > 0.0) {
+            return Err(Invalid::value(
+                "compress.rate",
+                num(c.rate),
+                "must be a positive finite number (relative growth per unit time)",
+            ));
+        }
+        match (c.target_packing_fraction, c.until) {
+            (Some(_), Some(_)) => {
+                return Err(Invalid::fields(
+                    "compress",
+                    "give either target_packing_fraction or until = \"jammed\", not both",
+                ));
+            }
+            (None, None) => {
+                return Err(Invalid::fields("compress", "give target_packing_fraction = φ or until = \"jammed\""));
+            }
+            (Some(target), None) => {
+                let (limit, formula) = close_packing(d);
+                let start = self.initial_packing_fraction(d);
+                if !(target.is_finite() && target > start && target < limit) {
+                    return Err(Invalid::value(
+                        "compress.target_packing_fraction",
+                        num(target),
+                        format!(
+                            "must lie between the initial packing fraction {} and close packing {limit} ({formula})",
+                            num(start)
+                        ),
+                    ));
+                }
+                for (field, given) in [
+                    ("compress.pressure_limit", c.pressure_limit.map(num)),
+                    ("compress.contact_tolerance", c.contact_tolerance.map(num)),
+                ] {
+                    if let Some(value) = given {
+                        return Err(Invalid::OnlyWith {
+                            field: field.into(),
+                            value,
+                            with: "compress.until = \"jammed\"".into(),
+                            allowed: "a compression to a packing fraction stops there (remove it)".into(),
+                        });
+                    }
+                }
+            }
+            (None, Some(Until::Jammed)) => {
+                if let Some(p) = c.pressure_limit
+                    && !(p.is_finite() && p > 10.0)
+                {
+                    return Err(Invalid::value(
+                        "compress.pressure_limit",
+                        num(p),
+                        "must be a finite reduced pressure above 10",
+                    ));
+                }
+                if let Some(t) = c.contact_tolerance
+                    && !(t.is_finite() && t > 0.0 && t < 0.1)
+                {
+                    return Err(Invalid::value(
+                        "compress.contact_tolerance",
+                        num(t),
+                        "must lie in (0, 0.1) (a fraction of the contact distance)",
+                    ));
+                }
+            }
+        }
+        if c.thermostat_every == Some(0) {
+            return Err(Invalid::value(
+                "compress.thermostat_every",
+                "0",
+                "must be at least 1 collision (leave it out for N)",
+            ));
+        }
+        Ok(())
+    }
+
     /// Validates every value for the dimension the configuration names, as
     /// [`parse`](Self::parse) does.
     pub fn check(&self) -> Result<(), Invalid> {
@@ -581,7 +747,28 @@ impl Config {
                 "the total kinetic energy overflows",
             ));
         }
-        if self.run.collisions.is_none() && self.run.time.is_none() {
+        self.check_compress(d)?;
+        let jamming = self.compress.as_ref().is_some_and(CompressConfig::to_jamming);
+        if jamming {
+            let given =
+                [("run.collisions", self.run.collisions.map(|c| c.to_string())), ("run.time", self.run.time.map(num))]
+                    .into_iter()
+                    .chain([
+                        ("equilibration.collisions", self.equilibration.collisions.map(|c| c.to_string())),
+                        ("equilibration.time", self.equilibration.time.map(num)),
+                    ]);
+            for (field, value) in given {
+                if let Some(value) = value {
+                    return Err(Invalid::OnlyWith {
+                        field: field.into(),
+                        value,
+                        with: "a compression to a packing fraction".into(),
+                        allowed: "with compress.until = \"jammed\" the run ends at the jammed packing (remove it)"
+                            .into(),
+                    });
+                }
+            }
+        } else if self.run.collisions.is_none() && self.run.time.is_none() {
             return Err(Invalid::fields("run", "give collisions and/or time (the run stops at whichever comes first)"));
         }
         if self.run.collisions == Some(0) {

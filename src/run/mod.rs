@@ -1,5 +1,5 @@
-//! A run: configuration → limits → initial state → equilibration → production with
-//! observers → summary, in `D` dimensions. [`Run`] owns the one loop of both phases
+//! A run: configuration → limits → initial state → (compression) → equilibration →
+//! production with observers → summary, in `D` dimensions. [`Run`] owns the one loop of both phases
 //! ([`Run::advance`]): after every event it feeds the run's own observers (in production)
 //! and a [`Sink`] given by the caller — the files of `collide run`, an experiment's own
 //! observers — stops at the next event when asked (a signal), and stops a run that no longer
@@ -13,6 +13,7 @@
 //! * [`output`], [`rundir`]: the files of `collide run` and the directory that holds them.
 
 pub mod checkpoint;
+pub mod compression;
 pub mod config;
 pub mod limits;
 pub mod output;
@@ -21,6 +22,7 @@ pub mod summary;
 pub mod watchdog;
 
 pub use checkpoint::{Checkpoint, CheckpointError, Saved, StateError};
+pub use compression::Compression;
 pub use config::{Config, ConfigError, Invalid};
 pub use limits::{Estimate, LimitError, Limits};
 pub use summary::{Summary, WallPressure};
@@ -101,10 +103,12 @@ pub struct Equilibration {
     pub time: f64,
 }
 
-/// The two phases of a run.
+/// The phases of a run.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
 #[serde(rename_all = "lowercase")]
 pub enum Phase {
+    /// With `[compress]`, first: until the compression is over; nothing is measured.
+    Compression,
     /// Until both of `[equilibration]`'s lengths are reached; nothing is measured.
     Equilibration,
     /// Until either of `[run]`'s lengths is reached, observed.
@@ -130,6 +134,9 @@ pub enum Status {
     Stalled,
     /// Stopped when it held [`Limits::max_samples`] samples.
     TooManySamples,
+    /// Its compression jammed before the packing fraction it asked for: the run ended at the
+    /// jammed packing (see the summary's `compression`).
+    Jammed,
 }
 
 impl Status {
@@ -187,6 +194,8 @@ pub struct Run<const D: usize> {
     pub observables: Vec<Observable>,
     /// What the equilibration did.
     pub equilibration: Equilibration,
+    /// The compression, with `[compress]`.
+    pub compression: Option<Compression>,
     /// What the run may cost, and the watchdog's tunables.
     pub limits: Limits,
     /// What the configuration is expected to cost.
@@ -238,7 +247,9 @@ fn admit<const D: usize>(config: &Config, limits: &Limits) -> Result<(SimBox<D>,
 
 /// Checks that `particles` are those `config`'s species ask for: as many of each species, with
 /// its radius and mass.
-fn check_particles<const D: usize>(config: &Config, particles: &[Particle<D>]) -> Result<(), StateError> {
+/// With `scaled` (a compression), every radius may be its species' times one common factor
+/// (to rounding, 10⁻¹²), at least 1.
+fn check_particles<const D: usize>(config: &Config, particles: &[Particle<D>], scaled: bool) -> Result<(), StateError> {
     let bad = |field: &'static str, found: String, expected: String| Err(StateError { field, found, expected });
     let n = config.n_particles();
     if particles.len() != n {
@@ -249,6 +260,10 @@ fn check_particles<const D: usize>(config: &Config, particles: &[Particle<D>]) -
         );
     }
     let mut counts = vec![0usize; config.species.len()];
+    let scale = match (scaled, particles.first()) {
+        (true, Some(p)) => config.species.get(p.species as usize).map_or(1.0, |s| p.radius / s.radius),
+        _ => 1.0,
+    };
     for (i, p) in particles.iter().enumerate() {
         let Some(s) = config.species.get(p.species as usize) else {
             return bad(
@@ -257,7 +272,12 @@ fn check_particles<const D: usize>(config: &Config, particles: &[Particle<D>]) -
                 format!("there are {}", config.species.len()),
             );
         };
-        if p.radius != s.radius || p.mass != s.mass {
+        let radius_fits = if scaled {
+            scale >= 1.0 && ((p.radius / s.radius) / scale - 1.0).abs() <= 1e-12
+        } else {
+            p.radius == s.radius
+        };
+        if !radius_fits || p.mass != s.mass {
             return bad(
                 "run.state.particles",
                 format!("particle {i} (species {}) has radius {} and mass {}", p.species, p.radius, p.mass),
@@ -304,7 +324,7 @@ impl<const D: usize> Run<D> {
             }
             error => RunError::Setup(error),
         })?;
-        Ok(Run::started(config, sim, limits, estimate))
+        Run::started(config, sim, limits, estimate)
     }
 
     /// A run of `config` from the given particles instead of its `[init]` (an experiment that
@@ -313,27 +333,60 @@ impl<const D: usize> Run<D> {
     pub fn from_particles(config: Config, particles: Vec<Particle<D>>) -> Result<Run<D>, RunError> {
         let limits = Limits::for_this_machine();
         let (sim_box, estimate) = admit::<D>(&config, &limits)?;
-        check_particles(&config, &particles).map_err(RunError::Particles)?;
+        check_particles(&config, &particles, false).map_err(RunError::Particles)?;
         let sim = Simulation::new(particles, sim_box).map_err(RunError::Setup)?;
-        Ok(Run::started(config, sim, limits, estimate))
+        Run::started(config, sim, limits, estimate)
     }
 
-    /// A run about to equilibrate `sim`.
-    fn started(config: Config, sim: Simulation<D>, limits: Limits, estimate: Estimate) -> Run<D> {
-        Run {
+    /// A run about to compress (with `[compress]`) or equilibrate `sim`.
+    fn started(config: Config, mut sim: Simulation<D>, limits: Limits, estimate: Estimate) -> Result<Run<D>, RunError> {
+        let compression = match config.compress {
+            Some(_) => Some(
+                Compression::start(&mut sim, &config).map_err(|e| RunError::Box { error: e.error, from: e.from })?,
+            ),
+            None => None,
+        };
+        Ok(Run {
+            phase: if compression.is_some() { Phase::Compression } else { Phase::Equilibration },
             config,
             start_counts: sim.counts(),
             thermo: Thermo::new(&sim),
             sim,
             observables: Vec::new(),
             equilibration: Equilibration::default(),
+            compression,
             limits,
             estimate,
-            phase: Phase::Equilibration,
             wall_before: 0.0,
             wall_since: None,
             ended: (Status::Complete, None),
+        })
+    }
+
+    /// Runs the compression, if any, to its end; `Some` when the run ends with it (jammed,
+    /// or stopped), else the equilibration starts.
+    fn compress<S: Sink<D>>(&mut self, stop: &AtomicBool, sink: &mut S) -> Result<Option<Status>, S::Error> {
+        if self.phase != Phase::Compression {
+            return Ok(None);
         }
+        if let Some(status) = self.drive(Phase::Compression, stop, sink)? {
+            return Ok(Some(status));
+        }
+        let to_jamming = self.config.compress.as_ref().is_some_and(|c| c.to_jamming());
+        match &self.compression {
+            Some(c) if to_jamming || !c.done => Ok(Some(Status::Complete)),
+            Some(c) if c.jammed => Ok(Some(Status::Jammed)),
+            _ => {
+                self.phase = Phase::Equilibration;
+                Ok(None)
+            }
+        }
+    }
+
+    /// The clock and the pair collisions when the equilibration started (after any
+    /// compression).
+    fn equilibration_start(&self) -> (f64, u64) {
+        self.compression.as_ref().map_or((0.0, 0), Compression::end_mark)
     }
 
     /// Runs the equilibration alone (the same loop as [`advance`](Self::advance)), then
@@ -341,6 +394,9 @@ impl<const D: usize> Run<D> {
     /// equilibration found ([`plan_production`](Self::plan_production)) before
     /// [`advance`](Self::advance) runs it. Nothing stops it but the watchdog.
     pub fn equilibrate<S: Sink<D>>(&mut self, sink: &mut S) -> Result<Status, S::Error> {
+        if let Some(status) = self.compress(&AtomicBool::new(false), sink)? {
+            return Ok(status);
+        }
         if self.phase == Phase::Equilibration {
             if let Some(status) = self.drive(Phase::Equilibration, &AtomicBool::new(false), sink)? {
                 return Ok(status);
@@ -388,16 +444,26 @@ impl<const D: usize> Run<D> {
             thermo,
             observables,
             equilibration,
+            compression,
             start_counts,
             wall_time_s,
             trajectory_bytes: _,
         } = checkpoint.run;
+        if compression.is_some() != config.compress.is_some()
+            || (phase == Phase::Compression) != compression.as_ref().is_some_and(|c| !c.done)
+        {
+            return Err(RunError::Checkpoint(CheckpointError::State(StateError {
+                field: "run.compression",
+                found: format!("a compression {:?} in phase {phase:?}", compression.as_ref().map(|c| c.done)),
+                expected: "one under way exactly in the compression phase, and only with [compress]".into(),
+            })));
+        }
         let (sim_box, estimate) =
             admit::<D>(&config, &limits).map_err(|e| RunError::Checkpoint(CheckpointError::Config(Box::new(e))))?;
         let bad = |field: &'static str, found: String, expected: String| {
             Err(RunError::Checkpoint(CheckpointError::State(StateError { field, found, expected })))
         };
-        if let Err(e) = check_particles(&config, &state.particles) {
+        if let Err(e) = check_particles(&config, &state.particles, compression.is_some()) {
             return Err(RunError::Checkpoint(CheckpointError::State(e)));
         }
         let c = &state.counts;
@@ -409,7 +475,7 @@ impl<const D: usize> Run<D> {
             );
         }
         let sampling = match phase {
-            Phase::Equilibration => None,
+            Phase::Compression | Phase::Equilibration => None,
             Phase::Production => Some(config.run.sample_interval),
         };
         if state.sampling != sampling {
@@ -462,6 +528,7 @@ impl<const D: usize> Run<D> {
             thermo,
             observables,
             equilibration,
+            compression,
             limits,
             estimate,
             start_counts,
@@ -481,6 +548,7 @@ impl<const D: usize> Run<D> {
             thermo: self.thermo.clone(),
             observables: self.observables.clone(),
             equilibration: self.equilibration,
+            compression: self.compression.clone(),
             start_counts: self.start_counts,
             wall_time_s: self.wall_time(),
             trajectory_bytes,
@@ -506,21 +574,25 @@ impl<const D: usize> Run<D> {
     /// reached): an equilibration is at least this long.
     fn equilibrated(&self) -> bool {
         let target = &self.config.equilibration;
-        self.sim.counts().pair >= target.collisions.unwrap_or(0) && self.sim.time() >= target.time.unwrap_or(0.0)
+        let (t0, c0) = self.equilibration_start();
+        self.sim.counts().pair - c0 >= target.collisions.unwrap_or(0)
+            && self.sim.time() - t0 >= target.time.unwrap_or(0.0)
     }
 
     /// The fraction of the equilibration done (the smaller of the two).
     fn equilibration_done(&self) -> f64 {
         let target = &self.config.equilibration;
-        let by_collisions = target.collisions.map_or(1.0, |c| self.sim.counts().pair as f64 / c.max(1) as f64);
-        let by_time = target.time.map_or(1.0, |t| if t > 0.0 { self.sim.time() / t } else { 1.0 });
+        let (t0, c0) = self.equilibration_start();
+        let by_collisions = target.collisions.map_or(1.0, |c| (self.sim.counts().pair - c0) as f64 / c.max(1) as f64);
+        let by_time = target.time.map_or(1.0, |t| if t > 0.0 { (self.sim.time() - t0) / t } else { 1.0 });
         by_collisions.min(by_time).min(1.0)
     }
 
     /// Starts production: the equilibration is recorded, the observers started afresh,
     /// sampling scheduled.
     fn start_production(&mut self) {
-        self.equilibration = Equilibration { collisions: self.sim.counts().pair, time: self.sim.time() };
+        let (t0, c0) = self.equilibration_start();
+        self.equilibration = Equilibration { collisions: self.sim.counts().pair - c0, time: self.sim.time() - t0 };
         self.thermo = Thermo::new(&self.sim);
         self.observables = self.config.observe.start(&self.sim);
         self.start_counts = self.sim.counts();
@@ -587,6 +659,9 @@ impl<const D: usize> Run<D> {
     }
 
     fn advance_inner<S: Sink<D>>(&mut self, stop: &AtomicBool, sink: &mut S) -> Result<Status, S::Error> {
+        if let Some(status) = self.compress(stop, sink)? {
+            return Ok(status);
+        }
         if self.phase == Phase::Equilibration {
             if let Some(status) = self.drive(Phase::Equilibration, stop, sink)? {
                 return Ok(status);
@@ -603,11 +678,20 @@ impl<const D: usize> Run<D> {
     /// observers see the events (production).
     fn drive<S: Sink<D>>(&mut self, phase: Phase, stop: &AtomicBool, sink: &mut S) -> Result<Option<Status>, S::Error> {
         let production = phase.is_production();
-        let done = |run: &Run<D>| if production { run.progress() } else { run.equilibration_done() };
+        let compressing = phase == Phase::Compression;
+        let done = |run: &Run<D>| match (phase, &run.compression) {
+            (Phase::Production, _) => run.progress(),
+            (Phase::Compression, Some(c)) => c.progress(&run.sim, &run.config),
+            _ => run.equilibration_done(),
+        };
         let limits = self.limits;
         let mut dog = Watchdog::new(&limits, self.sim.time(), done(self), self.sim.counts());
         let mut events = 0u64;
-        while !(if production { self.done() } else { self.equilibrated() }) {
+        while !(match phase {
+            Phase::Production => self.done(),
+            Phase::Equilibration => self.equilibrated(),
+            Phase::Compression => self.compression.as_ref().is_none_or(|c| c.done),
+        }) {
             if stop.load(Ordering::Relaxed) {
                 return Ok(Some(Status::Interrupted));
             }
@@ -615,13 +699,20 @@ impl<const D: usize> Run<D> {
                 return Ok(Some(Status::TooManySamples));
             }
             let Some(outcome) = self.sim.step() else { break };
+            if compressing && let Some(c) = self.compression.as_mut() {
+                // The compression watches its own pressure and ends itself (the engine's
+                // stall guard ends a growth at jamming): no watchdog.
+                c.observe(&mut self.sim, &self.config, &outcome);
+                c.over(&mut self.sim, &self.config);
+            }
             if production {
                 self.thermo.observe(&self.sim, &outcome);
                 for observable in &mut self.observables {
                     observable.observe(&self.sim, &outcome);
                 }
             }
-            if dog.due()
+            if !compressing
+                && dog.due()
                 && let Some(stall) = dog.look(&limits, self.sim.time(), done(self), self.sim.counts(), &outcome)
             {
                 self.ended = (Status::Stalled, Some(stall));

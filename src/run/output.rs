@@ -136,6 +136,10 @@ impl<const D: usize, P: FnMut(Phase, f64)> Sink<D> for Writer<'_, P> {
     type Error = OutputError;
 
     fn event(&mut self, run: &Run<D>, outcome: &Outcome<D>) -> Result<(), OutputError> {
+        if run.phase() == Phase::Compression && run.compression.as_ref().is_some_and(|c| c.done) {
+            // The compressed (or jammed) packing, once, as it stands at the compression's end.
+            self.dir.write("compressed.xyz", xyz_frame(&run.sim).as_bytes())?;
+        }
         if run.phase() != Phase::Production {
             return Ok(());
         }

@@ -54,6 +54,20 @@ impl<const D: usize> Run<D> {
                 samples.len()
             ));
         }
+        if let (Some(c), Some(compress)) = (&self.compression, &self.config.compress) {
+            if c.jammed && !compress.to_jamming() {
+                warnings.push(format!(
+                    "the packing jammed at φ = {:.6} before compress.target_packing_fraction = {}: the run ended at the jammed packing",
+                    c.packing_fraction,
+                    compress.target_packing_fraction.unwrap_or(f64::NAN)
+                ));
+            } else if c.done && compress.to_jamming() && !c.jammed {
+                warnings.push(format!(
+                    "the box cannot hold larger particles: the compression stopped at φ = {:.6} without jamming",
+                    c.packing_fraction
+                ));
+            }
+        }
         if production && self.ended.0 == Status::Complete && !self.done() {
             warnings
                 .push(format!("nothing can happen any more: the run ended at t = {} before its length", sim.time()));
@@ -66,7 +80,10 @@ impl<const D: usize> Run<D> {
             warnings,
             dimension: D,
             n_particles: n,
-            packing_fraction: particle_volume::<D>(&self.config.species) / sim_box.volume(),
+            packing_fraction: match &self.compression {
+                Some(_) => sim.packing_fraction(),
+                None => particle_volume::<D>(&self.config.species) / sim_box.volume(),
+            },
             seed: self.config.seed,
             box_lengths: sim_box.lengths.iter().copied().collect(),
             collisions: pair,
@@ -88,6 +105,7 @@ impl<const D: usize> Run<D> {
             max_overlap: audit,
             samples: samples.len(),
             equilibration: self.equilibration,
+            compression: self.compression.clone(),
             observables: self.observables.iter().map(|o| (o.name().to_string(), o.results())).collect(),
             config: self.config.clone(),
         }
@@ -180,6 +198,9 @@ pub struct Summary {
     pub samples: usize,
     /// The equilibration.
     pub equilibration: Equilibration,
+    /// The compression, with `[compress]` (absent without).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub compression: Option<super::Compression>,
     /// What the observables the configuration names measured, by name (absent: none).
     #[serde(default, skip_serializing_if = "BTreeMap::is_empty")]
     pub observables: BTreeMap<String, serde_json::Value>,

@@ -3,6 +3,7 @@
 #![allow(dead_code)]
 
 use collide::engine::{ReferenceSimulation, Simulation};
+use collide::run::Summary;
 
 /// A small mixture with walls along y, a trajectory and periodic checkpoints, that runs in
 /// a fraction of a second; the tests edit it.
@@ -66,4 +67,9 @@ pub fn assert_same_collisions<const D: usize>(
             "{label}, collision {k}: fast {got:?}, reference {expected:?}"
         );
     }
+}
+
+/// A summary without its wall-clock fields (the only ones a rerun changes).
+pub fn reproducible(summary: Summary) -> Summary {
+    Summary { wall_time_s: 0.0, collisions_per_second: 0.0, ..summary }
 }

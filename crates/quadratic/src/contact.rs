@@ -47,7 +47,10 @@
 //! or the inputs leave the range `2^±150` where the bounds are proved, does the exact
 //! expansion path run. Typical simulation pairs never reach it.
 
-use crate::exact::{Dd, Expansion, exponent, pow2, scale2, two_prod, two_sum};
+use crate::exact::{
+    Dd, Expansion, compress_in_place, dd_of_compressed, exponent, grow_in_place, pow2, scale2, sign_of, two_prod,
+    two_sum,
+};
 use core::cmp::Ordering;
 use core::fmt;
 
@@ -890,16 +893,7 @@ fn filtered<const D: usize, const BRACKET: bool>(first: &Ball<D>, second: &Ball<
         }
         acc.dd()
     };
-    let c_dd = {
-        let mut acc = Acc::default();
-        acc.prod(-s, s);
-        acc.small(-(2.0 * s).mul_add(st, st * st));
-        for &(h, l) in dr {
-            acc.prod(h, h);
-            acc.small((2.0 * h).mul_add(l, l * l));
-        }
-        acc.dd()
-    };
+    let c_dd = gap_dd(dr, sigma);
     let d_dd = {
         let mut a_acc = Acc::default();
         for &(g, m) in dv {
@@ -913,20 +907,7 @@ fn filtered<const D: usize, const BRACKET: bool>(first: &Ball<D>, second: &Ball<
         let mut acc = Acc::default();
         acc.prod(asig.hi, 1.0);
         acc.small(asig.lo);
-        for i in 0..D {
-            for j in i + 1..D {
-                let ((hi, li), (gi, mi)) = (dr[i], dv[i]);
-                let ((hj, lj), (gj, mj)) = (dr[j], dv[j]);
-                let mut x = Acc::default();
-                x.prod(hi, gj);
-                x.prod(-hj, gi);
-                x.small(hi.mul_add(mj, li * gj) - hj.mul_add(mi, lj * gi) + (li * mj - lj * mi));
-                let cross = x.dd();
-                let sq = cross.mul(cross);
-                acc.prod(-sq.hi, 1.0);
-                acc.small(-sq.lo);
-            }
-        }
+        acc.minus_cross_squares(dr, dv);
         acc.dd()
     };
     let den = neg_b.add(d_dd.sqrt());
@@ -1052,6 +1033,54 @@ fn widened_ends(
     ((lo * (1.0 - widen) - f64::MIN_POSITIVE).max(0.0), hi * (1.0 + widen) + f64::MIN_POSITIVE)
 }
 
+/// `C = |Δr|² − σ²` in double-double, from the exact differences (error below 2⁻⁹⁸ of
+/// `|Δr|² + σ²`; see [`filtered`]).
+#[inline(always)]
+pub(crate) fn gap_dd<const D: usize>(dr: &[Pair; D], (s, st): Pair) -> Dd {
+    let mut acc = Acc::default();
+    acc.prod(-s, s);
+    acc.small(-(2.0 * s).mul_add(st, st * st));
+    for &(h, l) in dr {
+        acc.prod(h, h);
+        acc.small((2.0 * h).mul_add(l, l * l));
+    }
+    acc.dd()
+}
+
+/// `C = |Δr|² − σ²` exactly, from the exact differences: every square split by TwoProd
+/// (`(h + l)² = h² + 2hl + l²`, each product a head and its exact error), the terms summed
+/// into an expansion on the stack (Shewchuk's GROW-EXPANSION, then COMPRESS). Returns its
+/// exact sign and its value as a double-double (~2⁻¹⁰⁴ relative, however much cancels) —
+/// near contact, where [`gap_dd`]'s accuracy is only absolute (2⁻⁹⁸ of `|Δr|² + σ²`) and a
+/// gap of 10⁻¹² diameters keeps 2⁻⁵⁸ of it. `None` when a product's error term would fall
+/// below 2⁻⁹⁶⁰ (near the subnormals, where TwoProd stops being exact): the caller then takes
+/// the exact path.
+#[inline]
+pub(crate) fn exact_gap<const D: usize>(dr: &[Pair; D], (s, t): Pair) -> Option<(Ordering, Dd)> {
+    const { assert!(D <= 9, "the stack holds 6·(D + 1) + 1 terms") };
+    const FLOOR: f64 = pow2(-960);
+    let mut e = [0.0f64; 64];
+    let mut len = 0;
+    let mut fine = true;
+    let mut square = |e: &mut [f64; 64], len: &mut usize, h: f64, l: f64, sign: f64| {
+        for (x, y) in [(h, h), (2.0 * h, l), (l, l)] {
+            let (p, err) = two_prod(x, y);
+            fine &= p == 0.0 || p.abs() >= FLOOR;
+            *len = grow_in_place(e, *len, sign * p);
+            *len = grow_in_place(e, *len, sign * err);
+        }
+    };
+    for &(h, l) in dr {
+        square(&mut e, &mut len, h, l, 1.0);
+    }
+    square(&mut e, &mut len, s, t, -1.0);
+    if !fine {
+        return None;
+    }
+    let len = compress_in_place(&mut e, len);
+    Some((sign_of(&e[..len]), dd_of_compressed(&e[..len])))
+}
+
 /// A double-double accumulator: heads summed exactly by TwoSum, tails in plain f64.
 #[derive(Default)]
 pub(crate) struct Acc {
@@ -1076,6 +1105,31 @@ impl Acc {
     #[inline(always)]
     pub(crate) fn dd(&self) -> Dd {
         Dd::new(self.hi, self.lo)
+    }
+    /// Adds `x²` for a double-double `x` (its head exactly, its tail as a small term).
+    #[inline(always)]
+    pub(crate) fn square(&mut self, x: Dd) {
+        let sq = x.mul(x);
+        self.prod(sq.hi, 1.0);
+        self.small(sq.lo);
+    }
+    /// Subtracts `|Δr ∧ Δv|² = Σ_{i<j}(ΔrᵢΔvⱼ − ΔrⱼΔvᵢ)²`, each cross product formed in
+    /// double-double from the exact differences.
+    #[inline(always)]
+    pub(crate) fn minus_cross_squares<const D: usize>(&mut self, dr: &[Pair; D], dv: &[Pair; D]) {
+        for i in 0..D {
+            for j in i + 1..D {
+                let ((hi, li), (gi, mi)) = (dr[i], dv[i]);
+                let ((hj, lj), (gj, mj)) = (dr[j], dv[j]);
+                let mut x = Acc::default();
+                x.prod(hi, gj);
+                x.prod(-hj, gi);
+                x.small(hi.mul_add(mj, li * gj) - hj.mul_add(mi, lj * gi) + (li * mj - lj * mi));
+                let sq = x.dd().mul(x.dd());
+                self.prod(-sq.hi, 1.0);
+                self.small(-sq.lo);
+            }
+        }
     }
 }
 
@@ -1195,13 +1249,7 @@ mod tests {
     /// widening's own), so the test tells a widening too small from a sufficient one.
     #[test]
     fn bracket_ends_hold_the_one_ulp_band() {
-        let mut state = 0x2545_F491_4F6C_DD1Du64;
-        let mut unit = move || {
-            state ^= state >> 12;
-            state ^= state << 25;
-            state ^= state >> 27;
-            (state.wrapping_mul(0x2545_F491_4F6C_DD1D) >> 11) as f64 / (1u64 << 53) as f64
-        };
+        let mut unit = crate::uniform_stream(0x2545_F491_4F6C_DD1Du64);
         let misses = |widen: f64, unit: &mut dyn FnMut() -> f64| {
             let mut missed = 0;
             for _ in 0..200_000 {

@@ -51,9 +51,13 @@
 //! As in [`contact_time`]: an f64 filter certifies the signs of `C`, `A`, `b` and `Δ` with
 //! rigorous error bounds and the root comes from double-double values; only when a sign is
 //! too close to call (`A` within a few ulps of 0, say) does the exact expansion path run.
+//! A gap too small for the double-double's absolute accuracy — a pair within about 10⁻⁶ of
+//! contact, as every neighbour is near jamming — is summed exactly on the stack instead
+//! (its sign exact, its value to 2⁻¹⁰⁴ of itself), so the filter still decides it.
 
 use crate::contact::{
-    Acc, DD_ACCEPT, Pair, SLACK, U, differences, filter_c, first_invalid, max_length, max_velocity, valid_balls,
+    Acc, DD_ACCEPT, Pair, SLACK, U, differences, exact_gap, filter_c, first_invalid, gap_dd, max_length, max_velocity,
+    valid_balls,
 };
 use crate::exact::{Dd, Expansion, exponent, pow2, scale2, two_sum};
 use crate::{Ball, Contact, ContactError, Field, Miss, contact_time, contact_time_unchecked};
@@ -300,16 +304,23 @@ fn filtered<const D: usize>(first: &Ball<D>, second: &Ball<D>, rates: [f64; 2]) 
     let bound_a = (D as f64 + 5.0) * U * pa + SLACK;
     let (c, q, bound_c) = filter_c(&h, s);
     let (approaching, receding) = (b < -bound_b, b > bound_b);
-    if c < -bound_c {
+    // A gap too small for the double-double's absolute accuracy (a pair near contact: what a
+    // compression meets all the time near jamming) is summed exactly instead: its sign and
+    // its value to 2⁻¹⁰⁴ of itself.
+    let (dr, dv, sigma) = differences(first, second, 0, 0);
+    let exact_c = if c.abs() < DD_ACCEPT * q { Some(exact_gap(&dr, sigma)?) } else { None };
+    let touching = match exact_c {
+        Some((sign, _)) => sign != Ordering::Greater,
+        None => c < 0.0,
+    };
+    if touching {
         return match (approaching, receding) {
             (true, _) => Some(Contact::Now),
             (_, true) => Some(Contact::Never(Miss::Receding)),
             _ => None,
         };
     }
-    if c <= bound_c {
-        return None;
-    }
+    debug_assert!(exact_c.is_some() || c > bound_c);
     // C > 0. Growth wins (A < 0): a contact, whatever b. Otherwise (A > 0) only an approach
     // whose paths truly cross.
     let growth_wins = a < -bound_a;
@@ -334,13 +345,13 @@ fn filtered<const D: usize>(first: &Ball<D>, second: &Ball<D>, rates: [f64; 2]) 
     }
     // Every sign is certified: the values, in double-double, each accepted when far enough
     // above its error bound.
-    if b.abs() < DD_ACCEPT * p || c < DD_ACCEPT * q || disc < DD_ACCEPT * scale_d {
+    if b.abs() < DD_ACCEPT * p || disc < DD_ACCEPT * scale_d {
         return None;
     }
     if receding && -a < DD_ACCEPT * pa {
         return None;
     }
-    let (dr, dv, (_, st)) = differences(first, second, 0, 0);
+    let st = sigma.1;
     let (gh, gl) = two_sum(rates[0], rates[1]);
     let neg_b = {
         let mut acc = Acc::default();
@@ -361,39 +372,13 @@ fn filtered<const D: usize>(first: &Ball<D>, second: &Ball<D>, rates: [f64; 2]) 
             w.prod(s, g);
             w.prod(-gh, h);
             w.small(s.mul_add(m, st * g) + st * m - (gh.mul_add(l, gl * h) + gl * l));
-            let w = w.dd();
-            let sq = w.mul(w);
-            acc.prod(sq.hi, 1.0);
-            acc.small(sq.lo);
+            acc.square(w.dd());
         }
-        for i in 0..D {
-            for j in i + 1..D {
-                let ((hi, li), (gi, mi)) = (dr[i], dv[i]);
-                let ((hj, lj), (gj, mj)) = (dr[j], dv[j]);
-                let mut x = Acc::default();
-                x.prod(hi, gj);
-                x.prod(-hj, gi);
-                x.small(hi.mul_add(mj, li * gj) - hj.mul_add(mi, lj * gi) + (li * mj - lj * mi));
-                let cross = x.dd();
-                let sq = cross.mul(cross);
-                acc.prod(-sq.hi, 1.0);
-                acc.small(-sq.lo);
-            }
-        }
+        acc.minus_cross_squares(&dr, &dv);
         acc.dd().sqrt()
     };
     let t = if approaching {
-        let c_dd = {
-            let mut acc = Acc::default();
-            acc.prod(-s, s);
-            acc.small(-(2.0 * s).mul_add(st, st * st));
-            for &(h, l) in &dr {
-                acc.prod(h, h);
-                acc.small((2.0 * h).mul_add(l, l * l));
-            }
-            acc.dd()
-        };
-        c_dd.div(neg_b.add(root))
+        exact_c.map_or_else(|| gap_dd(&dr, sigma), |(_, c)| c).div(neg_b.add(root))
     } else {
         // Receding while growth wins: t = (b + √Δ)/(−A).
         let neg_a = {
@@ -482,13 +467,7 @@ mod tests {
     /// on `A < 0`, would send them to the expansions, some twenty times slower.
     #[test]
     fn the_filter_decides_ordinary_pairs() {
-        let mut state = 0x9E37_79B9_7F4A_7C15u64;
-        let mut unit = move || {
-            state ^= state >> 12;
-            state ^= state << 25;
-            state ^= state >> 27;
-            (state.wrapping_mul(0x2545_F491_4F6C_DD1D) >> 11) as f64 / (1u64 << 53) as f64
-        };
+        let mut unit = crate::uniform_stream(0x9E37_79B9_7F4A_7C15u64);
         let (mut decided, mut growth_wins, cases) = (0, 0, 20_000);
         for _ in 0..cases {
             let p: [f64; 3] = core::array::from_fn(|_| 100.0 * unit());
@@ -511,6 +490,32 @@ mod tests {
         }
         assert!(decided as f64 >= 0.999 * cases as f64, "the filter decided only {decided} of {cases}");
         assert!(growth_wins > 10, "the family should hold pairs with A < 0 ({growth_wins})");
+    }
+
+    /// Near jamming every neighbour is a hair from contact: gaps of 10⁻¹⁵…10⁻⁶ diameters
+    /// (approaching, receding, sliding). The filter must still decide nearly all of them —
+    /// the gap summed exactly on the stack — and agree with the exact path; a filter that
+    /// sent them to the expansions made a compression to jamming spend most of its time there.
+    #[test]
+    fn the_filter_decides_pairs_near_contact() {
+        let mut unit = crate::uniform_stream(0x2545_F491_4F6C_DD1Du64);
+        let (mut decided, cases) = (0, 20_000);
+        for _ in 0..cases {
+            let p: [f64; 2] = [40.0 * unit(), 40.0 * unit()];
+            let angle = std::f64::consts::TAU * unit();
+            let (r1, r2) = (0.5 + 0.2 * unit(), 0.5 + 0.2 * unit());
+            let gap = 10f64.powf(-15.0 + 9.0 * unit());
+            let d = (r1 + r2) * (1.0 + gap);
+            let q = [p[0] + d * angle.cos(), p[1] + d * angle.sin()];
+            let v = [unit() - 0.5, unit() - 0.5];
+            let (a, b) = (ball(p, [0.0, 0.0], r1), ball(q, v, r2));
+            let rates = [1e-3 * r1, 1e-3 * r2];
+            if let Some(c) = filtered(&a, &b, rates) {
+                decided += 1;
+                assert_eq!(c, contact_time_growing_exact_path(&a, &b, rates), "{a:?} {b:?}");
+            }
+        }
+        assert!(decided as f64 >= 0.99 * cases as f64, "the filter decided only {decided} of {cases}");
     }
 
     #[test]

@@ -65,3 +65,16 @@ pub use contact::{
 pub use growing::contact_time_growing_exact_path;
 pub use growing::{contact_time_growing, contact_time_growing_unchecked};
 pub use roots::{Coefficient, Roots, SolveError, solve};
+
+/// Uniform numbers in [0, 1) from xorshift64* with a fixed seed: the unit tests' families,
+/// the same on every machine.
+#[cfg(test)]
+pub(crate) fn uniform_stream(seed: u64) -> impl FnMut() -> f64 {
+    let mut state = seed;
+    move || {
+        state ^= state >> 12;
+        state ^= state << 25;
+        state ^= state >> 27;
+        (state.wrapping_mul(0x2545_F491_4F6C_DD1D) >> 11) as f64 / (1u64 << 53) as f64
+    }
+}

@@ -10,7 +10,7 @@
 mod common;
 
 use common::families::{Grow, contact_families, contact_families_3d, growing_families, quadratic_families};
-use common::oracle::{check_roots, class3, exact_contact, exact_contact_growing};
+use common::oracle::{ExactContact, check_roots, class3, exact_contact, exact_contact_growing};
 use common::runner;
 use proptest::prelude::*;
 use proptest::strategy::BoxedStrategy;
@@ -103,17 +103,19 @@ fn quadratic_solver_contract_on_every_family() {
     publish("Quadratic solver", &rows);
 }
 
-fn score_contacts<const D: usize>(families: Vec<(&'static str, BoxedStrategy<(Ball<D>, Ball<D>)>)>) -> Vec<String> {
+/// Scores a contact kernel on its families: for each case, `answer` gives the kernel's
+/// answer, its exact path's, the oracle's and the textbook formula's. The kernel must agree
+/// with its exact path bit for bit, classify exactly and be within one ulp.
+fn score<T: std::fmt::Debug + Clone>(
+    families: Vec<(&'static str, BoxedStrategy<T>)>,
+    answer: impl Fn(&T) -> (Contact, Contact, ExactContact, Contact),
+) -> Vec<String> {
     let mut rows = Vec::new();
     for (name, strategy) in families {
         let score = RefCell::new(Score::default());
-        let result = runner(CASES).run(&strategy, |(p, q)| {
-            let got = quadratic::contact_time(&p, &q).expect("valid inputs");
-            // The exact path alone must give the identical answer: both paths are proved.
-            let slow = quadratic::contact_time_exact_path(&p, &q);
-            prop_assert_eq!(got, slow, "filter and exact path disagree for {:?} {:?}", p, q);
-            let exact = exact_contact(&p, &q);
-            let naive = textbook::contact_time(&p, &q);
+        let result = runner(CASES).run(&strategy, |case| {
+            let (got, slow, exact, naive) = answer(&case);
+            prop_assert_eq!(got, slow, "filter and exact path disagree for {:?}", case);
             let ulps = |c: &Contact| match *c {
                 Contact::At(t) => exact.ulps(t),
                 _ => 0.0,
@@ -133,8 +135,8 @@ fn score_contacts<const D: usize>(families: Vec<(&'static str, BoxedStrategy<(Ba
                 s.textbook_wrong += 1;
             }
             drop(s);
-            prop_assert!(class_ok, "{p:?} {q:?}: got {got:?}, exact {:?}", exact.class);
-            prop_assert!(u <= 1.0, "{p:?} {q:?}: {got:?} is {u} ulp from the exact time");
+            prop_assert!(class_ok, "{case:?}: got {got:?}, exact {:?}", exact.class);
+            prop_assert!(u <= 1.0, "{case:?}: {got:?} is {u} ulp from the exact time");
             Ok(())
         });
         if let Err(e) = result {
@@ -143,6 +145,17 @@ fn score_contacts<const D: usize>(families: Vec<(&'static str, BoxedStrategy<(Ba
         rows.push(row(name, &score.into_inner()));
     }
     rows
+}
+
+fn score_contacts<const D: usize>(families: Vec<(&'static str, BoxedStrategy<(Ball<D>, Ball<D>)>)>) -> Vec<String> {
+    score(families, |(p, q)| {
+        (
+            quadratic::contact_time(p, q).expect("valid inputs"),
+            quadratic::contact_time_exact_path(p, q),
+            exact_contact(p, q),
+            textbook::contact_time(p, q),
+        )
+    })
 }
 
 #[test]
@@ -156,45 +169,14 @@ fn contact_time_contract_on_every_family_3d() {
 }
 
 fn score_growing<const D: usize>(families: Vec<(&'static str, BoxedStrategy<Grow<D>>)>) -> Vec<String> {
-    let mut rows = Vec::new();
-    for (name, strategy) in families {
-        let score = RefCell::new(Score::default());
-        let result = runner(CASES).run(&strategy, |(p, q, rates)| {
-            let got = quadratic::contact_time_growing(&p, &q, rates).expect("valid inputs");
-            // The exact path alone must give the identical answer: both paths are proved.
-            let slow = quadratic::contact_time_growing_exact_path(&p, &q, rates);
-            prop_assert_eq!(got, slow, "filter and exact path disagree for {:?} {:?} {:?}", p, q, rates);
-            let exact = exact_contact_growing(&p, &q, rates);
-            let naive = textbook::contact_time_growing(&p, &q, rates);
-            let ulps = |c: &Contact| match *c {
-                Contact::At(t) => exact.ulps(t),
-                _ => 0.0,
-            };
-            let class_ok = std::mem::discriminant(&got) == std::mem::discriminant(&exact.class)
-                && (matches!(got, Contact::At(_)) || got == exact.class);
-            let u = if class_ok { ulps(&got) } else { 0.0 };
-            let mut s = score.borrow_mut();
-            s.cases += 1;
-            s.wrong += usize::from(!class_ok);
-            s.max_ulps = s.max_ulps.max(u);
-            if class3(&naive) == class3(&exact.class) {
-                let nu = ulps(&naive);
-                s.textbook_over_1ulp += usize::from(!(nu <= 1.0));
-                s.textbook_max_ulps = s.textbook_max_ulps.max(nu);
-            } else {
-                s.textbook_wrong += 1;
-            }
-            drop(s);
-            prop_assert!(class_ok, "{p:?} {q:?} {rates:?}: got {got:?}, exact {:?}", exact.class);
-            prop_assert!(u <= 1.0, "{p:?} {q:?} {rates:?}: {got:?} is {u} ulp from the exact time");
-            Ok(())
-        });
-        if let Err(e) = result {
-            panic!("family '{name}': {e}");
-        }
-        rows.push(row(name, &score.into_inner()));
-    }
-    rows
+    score(families, |(p, q, rates)| {
+        (
+            quadratic::contact_time_growing(p, q, *rates).expect("valid inputs"),
+            quadratic::contact_time_growing_exact_path(p, q, *rates),
+            exact_contact_growing(p, q, *rates),
+            textbook::contact_time_growing(p, q, *rates),
+        )
+    })
 }
 
 #[test]

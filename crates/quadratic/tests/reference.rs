@@ -47,13 +47,12 @@ fn stored_exact_answers_are_exact() {
             wrong.push(format!("{}: stored {:?}, exact: {fix}", case.name, case.exact));
         }
     }
-    for case in CONTACT_CASES {
-        let exact = exact_contact(&case.first, &case.second);
+    let mut check = |name: &str, stored: Contact, exact: common::oracle::ExactContact| {
         let exact = match exact.class {
             Contact::At(_) => Contact::At(exact.time_rounded()),
             other => other,
         };
-        let same = match (exact, case.exact) {
+        let same = match (exact, stored) {
             (Contact::At(x), Contact::At(y)) => x.to_bits() == y.to_bits(),
             (x, y) => x == y,
         };
@@ -62,26 +61,14 @@ fn stored_exact_answers_are_exact() {
                 Contact::At(t) => format!("Contact::At({})", literal(t)),
                 other => format!("Contact::{other:?}"),
             };
-            wrong.push(format!("{}: stored {:?}, exact: {fix}", case.name, case.exact));
+            wrong.push(format!("{name}: stored {stored:?}, exact: {fix}"));
         }
+    };
+    for case in CONTACT_CASES {
+        check(case.name, case.exact, exact_contact(&case.first, &case.second));
     }
     for case in GROWING_CASES {
-        let exact = exact_contact_growing(&case.first, &case.second, case.rates);
-        let exact = match exact.class {
-            Contact::At(_) => Contact::At(exact.time_rounded()),
-            other => other,
-        };
-        let same = match (exact, case.exact) {
-            (Contact::At(x), Contact::At(y)) => x.to_bits() == y.to_bits(),
-            (x, y) => x == y,
-        };
-        if !same {
-            let fix = match exact {
-                Contact::At(t) => format!("Contact::At({})", literal(t)),
-                other => format!("Contact::{other:?}"),
-            };
-            wrong.push(format!("{}: stored {:?}, exact: {fix}", case.name, case.exact));
-        }
+        check(case.name, case.exact, exact_contact_growing(&case.first, &case.second, case.rates));
     }
     assert!(wrong.is_empty(), "stored reference answers are wrong:\n{}", wrong.join("\n"));
 }

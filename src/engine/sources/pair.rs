@@ -17,7 +17,7 @@
 //! through its batch search (`engine/search.rs`), which gives the same times bit for bit;
 //! the reference engine calls [`predict`] for every pair.
 
-use crate::engine::collision::{Body, Impulse, Restitution, resolve_growing_pair, resolve_pair};
+use crate::engine::collision::{Body, Impulse, Restitution, resolve_growing_pair};
 use crate::engine::geometry::{Boundary, Particle, SimBox};
 use crate::engine::motion::Radii;
 use nalgebra::SVector;
@@ -248,11 +248,7 @@ pub fn resolve<const D: usize>(
     let (pi, pj) = (&particles[i], &particles[j]);
     let mut a = Body { position: ri, velocity: pi.velocity, mass: pi.mass };
     let mut b = Body { position: rj, velocity: pj.velocity, mass: pj.mass };
-    let impulse = if radii.growing() {
-        resolve_growing_pair(&mut a, &mut b, restitution, radii.speed(pi.radius) + radii.speed(pj.radius))
-    } else {
-        resolve_pair(&mut a, &mut b, restitution)
-    };
+    let impulse = resolve_growing_pair(&mut a, &mut b, restitution, radii.speed(pi.radius) + radii.speed(pj.radius));
     for (k, body) in [(i, a), (j, b)] {
         particles[k].velocity = body.velocity;
         particles[k].events = particles[k].events.wrapping_add(1);
