@@ -164,3 +164,21 @@ fn collide_run_writes_the_compressed_packing() {
     assert!(summary["compression"].get("window").is_none());
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+/// Compressed too fast (rate 0.1), 200 disks reach the pressure limit with no contact network
+/// at all — the pressure of the growth itself — and the summary says so instead of passing
+/// it off as a jammed packing.
+#[test]
+fn a_pressure_without_a_contact_network_is_flagged() {
+    let c = config(2, 200, 0.5, "rate = 0.1\nuntil = \"jammed\"\npressure_limit = 1e10", "");
+    let mut run = Run::<2>::new(c).unwrap();
+    run.complete(&mut collide::run::Discard).unwrap();
+    let summary = run.summary();
+    let jam = summary.compression.clone().unwrap();
+    assert_eq!(jam.rattlers, Some(200), "{jam:?}");
+    assert!(
+        summary.warnings.iter().any(|w| w.contains("no contact network holding any particle")),
+        "{:?}",
+        summary.warnings
+    );
+}

@@ -61,6 +61,11 @@ impl<const D: usize> Run<D> {
                     c.packing_fraction,
                     compress.target_packing_fraction.unwrap_or(f64::NAN)
                 ));
+            } else if c.jammed && c.rattlers == Some(self.sim.particles().len()) {
+                warnings.push(format!(
+                    "the pressure limit was reached at φ = {:.6} with no contact network holding any particle: a pressure of the compression itself (growth faster than the particles can follow), not a jammed packing; use a smaller compress.rate",
+                    c.packing_fraction
+                ));
             } else if c.done && compress.to_jamming() && !c.jammed {
                 warnings.push(format!(
                     "the box cannot hold larger particles: the compression stopped at φ = {:.6} without jamming",
