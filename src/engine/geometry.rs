@@ -34,6 +34,13 @@ impl<const D: usize> SimBox<D> {
         self.boundary.iter().filter(|b| **b == Boundary::Periodic).count()
     }
 
+    /// Degrees of freedom of the kinetic energy of `n` particles in this box: `d·n` less one
+    /// per periodic axis (the total momentum along a periodic axis is conserved, and zeroed
+    /// by the initial state).
+    pub fn degrees_of_freedom(&self, n: usize) -> f64 {
+        (D * n - self.periodic_axes()) as f64
+    }
+
     /// The image shift to add to `d = r_j − r_i` so that each periodic component lies in
     /// `[−L/2, L/2]` (minimum image); zero along walled axes. Always `count·L` for the
     /// integer counts of [`minimum_image_count`](Self::minimum_image_count).

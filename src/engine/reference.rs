@@ -134,7 +134,7 @@ impl<const D: usize> ReferenceSimulation<D> {
         let radii = self.radii();
         let outcome =
             sources::resolve(&mut self.particles, &self.sim_box, None, Restitution::ELASTIC, radii, owner, &e);
-        let dof = (D * self.particles.len() - self.sim_box.periodic_axes()) as f64;
+        let dof = self.sim_box.degrees_of_freedom(self.particles.len());
         if let (Some(growth), Outcome::Pair { .. }) = (&mut self.growth, &outcome)
             && growth.after_collision(&mut self.particles, e.time, dof) == AfterCollision::Stalled
         {

@@ -489,7 +489,7 @@ impl<const D: usize> Simulation<D> {
     /// Degrees of freedom of the kinetic energy: `d·N` less one per periodic axis (the total
     /// momentum along a periodic axis is conserved, and zeroed by the initial state).
     pub fn degrees_of_freedom(&self) -> f64 {
-        (D * self.particles.len() - self.sim_box.periodic_axes()) as f64
+        self.sim_box.degrees_of_freedom(self.particles.len())
     }
 
     /// kT = 2K / (degrees of freedom).
@@ -654,9 +654,11 @@ impl<const D: usize> Simulation<D> {
                 &next,
             );
             self.counts.record(&outcome);
-            let dof = self.degrees_of_freedom();
             let after = match (&mut self.growth, &outcome) {
-                (Some(growth), Outcome::Pair { .. }) => growth.after_collision(&mut self.particles, next.time, dof),
+                (Some(growth), Outcome::Pair { .. }) => {
+                    let dof = self.sim_box.degrees_of_freedom(self.particles.len());
+                    growth.after_collision(&mut self.particles, next.time, dof)
+                }
                 _ => AfterCollision::Counted,
             };
             if after == AfterCollision::Stalled {

@@ -532,9 +532,11 @@ impl Config {
         match (self.sim_box.packing_fraction, &self.sim_box.size) {
             (Some(eta), _) => eta,
             (None, Some(size)) => {
-                let volume: f64 = size.iter().product();
-                let unit = if d == 3 { 4.0 / 3.0 * std::f64::consts::PI } else { std::f64::consts::PI };
-                self.species.iter().map(|s| s.count as f64 * unit * s.radius.powi(d as i32)).sum::<f64>() / volume
+                let volume = match d {
+                    3 => crate::engine::init::particle_volume::<3>(&self.species),
+                    _ => crate::engine::init::particle_volume::<2>(&self.species),
+                };
+                volume / size.iter().product::<f64>()
             }
             (None, None) => f64::NAN,
         }

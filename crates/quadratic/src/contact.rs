@@ -710,11 +710,55 @@ fn exact_full<const D: usize>(first: &Ball<D>, second: &Ball<D>) -> Contact {
     // differences are redone with lengths and/or velocities scaled by 2⁻⁴ (which can only
     // drop subnormal bits of inputs 2²⁰⁰⁰ times smaller than the largest — see the contract).
     let (dr, dv, sigma) = differences(first, second, 0, 0);
-    let safe = |m: f64| m < pow2(1020);
-    let (lpre, vpre) =
-        (if safe(max_length(&dr, sigma)) { 0 } else { -4 }, if safe(max_velocity(&dv)) { 0 } else { -4 });
+    let (lpre, vpre) = prescale(&dr, &dv, sigma, None);
     let (dr, dv, sigma) = if lpre == 0 && vpre == 0 { (dr, dv, sigma) } else { differences(first, second, lpre, vpre) };
     contact_of_differences(&dr, &dv, sigma, vpre - lpre)
+}
+
+/// The powers of two (0 or −4) by which lengths and velocities must be scaled before the
+/// exact path, so that nothing near the top of the range overflows: −4 where the largest
+/// head (of `Δr` and `σ`; of `Δv` and the growth head `grow`, if any) is not below 2¹⁰²⁰
+/// (or is not a number).
+pub(crate) fn prescale<const D: usize>(dr: &[Pair; D], dv: &[Pair; D], sigma: Pair, grow: Option<f64>) -> (i32, i32) {
+    let safe = |m: f64| m < pow2(1020);
+    let vm = max_velocity(dv);
+    let vm = match grow {
+        Some(g) if g.is_nan() || g > vm => g,
+        _ => vm,
+    };
+    (if safe(max_length(dr, sigma)) { 0 } else { -4 }, if safe(vm) { 0 } else { -4 })
+}
+
+/// The exponents `(el, ev)` that scale the exact differences' lengths and velocities (the
+/// growth head `grow` among them, if any) to magnitude [1, 2) — or the answer, when nothing
+/// moves (`Δv = 0` and no growth: no relative motion) or nothing has extent (`Δr = 0` and
+/// `σ = 0`: tangential).
+pub(crate) fn scale_exponents<const D: usize>(
+    dr: &[Pair; D],
+    dv: &[Pair; D],
+    sigma: Pair,
+    grow: Option<f64>,
+) -> Result<(i32, i32), Contact> {
+    // A TwoSum head is 0 exactly when the sum is.
+    let vmax = match grow {
+        Some(g) => max_velocity(dv).max(g.abs()),
+        None => max_velocity(dv),
+    };
+    if vmax == 0.0 {
+        return Err(Contact::Never(Miss::NoRelativeMotion));
+    }
+    let lmax = max_length(dr, sigma);
+    if lmax == 0.0 {
+        // Δr = 0 and σ = 0: b = 0 (and C = 0), tangential.
+        return Err(Contact::Never(Miss::Receding));
+    }
+    Ok((exponent(lmax), exponent(vmax)))
+}
+
+/// `(hi, lo)` scaled by `2^k`.
+#[inline(always)]
+pub(crate) fn scale_pair(p: Pair, k: i32) -> Pair {
+    (scale2(p.0, k), scale2(p.1, k))
 }
 
 /// `Δr`, `Δv`, `σ` as exact TwoSum pairs, lengths scaled by `2^lpre`, velocities by `2^vpre`.
@@ -761,23 +805,15 @@ pub(crate) fn max_velocity<const D: usize>(dv: &[Pair; D]) -> f64 {
 /// The contact given exact differences `Δr`, `Δv`, `σ` as (hi, lo) pairs, by the exact
 /// path; the resulting time is multiplied by `2^time_exp`.
 fn contact_of_differences<const D: usize>(dr: &[Pair; D], dv: &[Pair; D], sigma: Pair, time_exp: i32) -> Contact {
-    // Δv = 0 exactly iff every TwoSum head is 0.
-    let vmax = max_velocity(dv);
-    if vmax == 0.0 {
-        return Contact::Never(Miss::NoRelativeMotion);
-    }
-    let lmax = max_length(dr, sigma);
-    if lmax == 0.0 {
-        // Δr = 0 and σ = 0: b = 0, tangential.
-        return Contact::Never(Miss::Receding);
-    }
     // Scale lengths and velocities separately to magnitude [1, 2): exact (but for the
     // underflow caveat in the contract), and the time scales by 2^(el − ev).
-    let (el, ev) = (exponent(lmax), exponent(vmax));
-    let sp = |p: Pair, k: i32| (scale2(p.0, k), scale2(p.1, k));
-    let dr = dr.map(|p| sp(p, -el));
-    let dv = dv.map(|p| sp(p, -ev));
-    exact(&dr, &dv, sp(sigma, -el), time_exp + el - ev)
+    let (el, ev) = match scale_exponents(dr, dv, sigma, None) {
+        Ok(exponents) => exponents,
+        Err(answer) => return answer,
+    };
+    let dr = dr.map(|p| scale_pair(p, -el));
+    let dv = dv.map(|p| scale_pair(p, -ev));
+    exact(&dr, &dv, scale_pair(sigma, -el), time_exp + el - ev)
 }
 
 // ---------------------------------------------------------------------------------------

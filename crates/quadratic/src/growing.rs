@@ -56,8 +56,8 @@
 //! (its sign exact, its value to 2⁻¹⁰⁴ of itself), so the filter still decides it.
 
 use crate::contact::{
-    Acc, DD_ACCEPT, Pair, SLACK, U, differences, exact_gap, filter_c, first_invalid, gap_dd, max_length, max_velocity,
-    valid_balls,
+    Acc, DD_ACCEPT, Pair, SLACK, U, differences, exact_gap, filter_c, first_invalid, gap_dd, prescale, scale_exponents,
+    scale_pair, valid_balls,
 };
 use crate::exact::{Dd, Expansion, exponent, pow2, scale2, two_sum};
 use crate::{Ball, Contact, ContactError, Field, Miss, contact_time, contact_time_unchecked};
@@ -146,10 +146,7 @@ fn exact_full<const D: usize>(first: &Ball<D>, second: &Ball<D>, rates: [f64; 2]
         (dr, dv, sigma, two_sum(vel(rates[0]), vel(rates[1])))
     };
     let (dr, dv, sigma, grow) = differences_at(0, 0);
-    let safe = |m: f64| m < pow2(1020);
-    let vm = max_velocity(&dv);
-    let vm = if grow.0.is_nan() || grow.0 > vm { grow.0 } else { vm };
-    let (lpre, vpre) = (if safe(max_length(&dr, sigma)) { 0 } else { -4 }, if safe(vm) { 0 } else { -4 });
+    let (lpre, vpre) = prescale(&dr, &dv, sigma, Some(grow.0));
     let (dr, dv, sigma, grow) = if lpre == 0 && vpre == 0 { (dr, dv, sigma, grow) } else { differences_at(lpre, vpre) };
     of_differences(&dr, &dv, sigma, grow, vpre - lpre)
 }
@@ -157,21 +154,15 @@ fn exact_full<const D: usize>(first: &Ball<D>, second: &Ball<D>, rates: [f64; 2]
 /// The contact given exact differences `Δr`, `Δv`, `σ` and the growth `G` as (hi, lo)
 /// pairs, by the exact path; the time is multiplied by `2^time_exp`.
 fn of_differences<const D: usize>(dr: &[Pair; D], dv: &[Pair; D], sigma: Pair, grow: Pair, time_exp: i32) -> Contact {
-    // A TwoSum head is 0 exactly when the sum is: Δv = 0 and G = 0 means nothing changes.
-    let vmax = max_velocity(dv).max(grow.0.abs());
-    if vmax == 0.0 {
-        return Contact::Never(Miss::NoRelativeMotion);
-    }
-    let lmax = max_length(dr, sigma);
-    if lmax == 0.0 {
-        // Δr = 0 and σ = 0: b = 0 and C = 0, tangential.
-        return Contact::Never(Miss::Receding);
-    }
-    // Lengths and velocities scaled separately to magnitude [1, 2): exact (but for the
-    // underflow caveat of the contract); the time scales by 2^(el − ev).
-    let (el, ev) = (exponent(lmax), exponent(vmax));
-    let sp = |p: Pair, k: i32| (scale2(p.0, k), scale2(p.1, k));
-    exact(&dr.map(|p| sp(p, -el)), &dv.map(|p| sp(p, -ev)), sp(sigma, -el), sp(grow, -ev), time_exp + el - ev)
+    // Δv = 0 and G = 0: nothing changes. Lengths and velocities scaled separately to
+    // magnitude [1, 2): exact (but for the underflow caveat of the contract); the time
+    // scales by 2^(el − ev).
+    let (el, ev) = match scale_exponents(dr, dv, sigma, Some(grow.0)) {
+        Ok(exponents) => exponents,
+        Err(answer) => return answer,
+    };
+    let (dr, dv) = (dr.map(|p| scale_pair(p, -el)), dv.map(|p| scale_pair(p, -ev)));
+    exact(&dr, &dv, scale_pair(sigma, -el), scale_pair(grow, -ev), time_exp + el - ev)
 }
 
 /// The exact path on scaled differences: every sign from expansions, the root in
