@@ -182,3 +182,80 @@ fn a_pressure_without_a_contact_network_is_flagged() {
         summary.warnings
     );
 }
+
+/// Where packing codes give up: a polydisperse mixture (ten radii from 0.4 to 0.6), a 1 : 10
+/// size ratio, fifty spheres in a periodic box some three diameters wide, fifty particles
+/// between walls — each compressed through `[compress]` in a run, to jamming (or, for the
+/// 1 : 10 mixture, to a dense target), with no overlap beyond rounding, and, where jammed, a
+/// contact network that is at most isostatic. The neighbourhood is sized for the final radii
+/// (or, where a periodic axis is too short for four cells, searched over images): no "system
+/// too small".
+#[test]
+fn polydisperse_size_asymmetric_small_and_walled_systems_compress() {
+    let run = |dimension: usize, text: String| -> Summary {
+        let config = Config::parse(&format!("dimension = {dimension}\nseed = 3\n{text}"), "where-others-fail").unwrap();
+        match dimension {
+            2 => {
+                let mut run = Run::<2>::new(config).unwrap();
+                assert_eq!(run.complete(&mut collide::run::Discard).unwrap(), Status::Complete);
+                run.summary()
+            }
+            _ => {
+                let mut run = Run::<3>::new(config).unwrap();
+                assert_eq!(run.complete(&mut collide::run::Discard).unwrap(), Status::Complete);
+                run.summary()
+            }
+        }
+    };
+    let species = |list: &[(usize, f64, f64)]| {
+        list.iter()
+            .map(|(n, r, m)| format!("[[species]]\ncount = {n}\nradius = {r:?}\nmass = {m:?}\n"))
+            .collect::<String>()
+    };
+    let jam = "[init]\nplacement = \"random\"\n[compress]\nrate = 0.01\nuntil = \"jammed\"\n";
+    let poly: Vec<(usize, f64, f64)> = (0..10).map(|k| (10, 0.4 + 0.2 * k as f64 / 9.0, 1.0)).collect();
+    let cases = [
+        ("polydisperse disks", 2, format!("[box]\npacking_fraction = 0.5\nboundary = \"periodic\"\n{jam}{}", species(&poly)), 0.80..0.88),
+        (
+            "50 spheres, periodic",
+            3,
+            format!("[box]\npacking_fraction = 0.3\nboundary = \"periodic\"\n{jam}pressure_limit = 1e4\n{}", species(&[(50, 0.5, 1.0)])),
+            0.60..0.68,
+        ),
+        (
+            "50 disks between walls",
+            2,
+            format!("[box]\npacking_fraction = 0.4\nboundary = \"wall\"\n{jam}{}", species(&[(25, 0.5, 1.0), (25, 0.7, 1.0)])),
+            0.70..0.86,
+        ),
+        (
+            "50 spheres between walls",
+            3,
+            format!("[box]\npacking_fraction = 0.25\nboundary = \"wall\"\n{jam}{}", species(&[(25, 0.5, 1.0), (25, 0.7, 1.0)])),
+            0.45..0.62,
+        ),
+    ];
+    for (label, d, text, range) in cases {
+        let summary = run(d, text);
+        let c = summary.compression.clone().unwrap();
+        assert!(c.jammed && range.contains(&c.packing_fraction), "{label}: {c:?}");
+        assert!(c.max_overlap <= 1e-12, "{label}: {c:?}");
+        let (z, rattlers) = (c.contacts_per_particle.unwrap(), c.rattlers.unwrap());
+        let n = summary.n_particles;
+        assert!(rattlers < n && z > d as f64, "{label}: {c:?}");
+        // At most isostatic: d(N′ − 1) + 1 periodic; between walls (no free translation) dN′.
+        let held = (n - rattlers) as f64;
+        assert!(z * held / 2.0 <= d as f64 * held + 1.0, "{label}: z = {z} with {held} held");
+    }
+    // 1 : 10: ten large disks among a hundred small ones, compressed to φ = 0.75 and run there.
+    let text = format!(
+        "[box]\npacking_fraction = 0.4\nboundary = \"periodic\"\n[init]\nplacement = \"random\"\n\
+         [compress]\nrate = 0.01\ntarget_packing_fraction = 0.75\n[equilibration]\ncollisions = 1000\n[run]\ncollisions = 5000\n{}",
+        species(&[(10, 0.5, 1.0), (100, 0.05, 0.01)])
+    );
+    let summary = run(2, text);
+    let c = summary.compression.clone().unwrap();
+    assert!(!c.jammed && (summary.packing_fraction - 0.75).abs() <= 1e-12, "1:10: {c:?}");
+    assert!(summary.max_overlap.fraction <= 1e-12 && c.max_overlap <= 1e-12, "1:10: {c:?}");
+    assert_eq!(summary.collisions, 5000);
+}

@@ -106,9 +106,11 @@ fn equation_of_state_quick_passes_and_writes_points() {
     let json: serde_json::Value =
         serde_json::from_str(&std::fs::read_to_string(dir.join("equation_of_state/result.json")).unwrap()).unwrap();
     let points = json["data"]["points"].as_array().unwrap();
-    assert_eq!(points.len(), 4);
+    assert_eq!(points.len(), 5);
+    let starts: Vec<&str> = points.iter().map(|p| p["start"].as_str().unwrap()).collect();
+    assert_eq!(starts, ["lattice", "lattice", "lattice", "lattice", "compression"]);
     for p in points {
-        for key in ["eta", "Z", "Z_err", "n_particles", "collisions"] {
+        for key in ["eta", "Z", "Z_err", "n_particles", "collisions", "order"] {
             assert!(p.get(key).is_some(), "a point lacks {key}");
         }
     }
@@ -120,7 +122,9 @@ fn equation_of_state_quick_passes_and_writes_points() {
 /// gas where the fluid is dense — in both dimensions and both phases of spheres.
 #[test]
 fn equation_of_state_references_and_checks_can_fail() {
-    use collide::lab::equation_of_state::{Phase, Point, check_point, z_henderson, z_liu_disks, z_slhy, z_virial};
+    use collide::lab::equation_of_state::{
+        Phase, Point, Start, check_point, check_still_fluid, z_henderson, z_liu_disks, z_slhy, z_virial,
+    };
     use collide::theory::{z_hansen_goos, z_speedy_fcc};
     assert_eq!(z_henderson(0.5), 4.125);
     // SLHY at η = 0.5: 1/(2η_cp−1)η²/η_cp²) with 1 − 2η = 0.
@@ -138,6 +142,8 @@ fn equation_of_state_references_and_checks_can_fail() {
         n_particles: 2048,
         collisions: 2_000_000,
         equilibration_per_particle: 500.0,
+        start: Start::Lattice,
+        order: 0.01,
     };
     let cases = [
         (2, Phase::Fluid, 0.1, z_virial(0.1)),
@@ -145,6 +151,7 @@ fn equation_of_state_references_and_checks_can_fail() {
         (2, Phase::Fluid, 0.5, z_liu_disks(0.5)),
         (3, Phase::Fluid, 0.3, z_hansen_goos(0.3)),
         (3, Phase::Fluid, 0.49, z_hansen_goos(0.49)),
+        (3, Phase::Fluid, 0.52, z_hansen_goos(0.52)),
         (3, Phase::Fcc, 0.6, z_speedy_fcc(0.6)),
         (3, Phase::Fcc, 0.7, z_speedy_fcc(0.7)),
     ];
@@ -167,11 +174,19 @@ fn equation_of_state_references_and_checks_can_fail() {
     assert!(!at(z_henderson(0.5)).pass, "{:?}", at(z_henderson(0.5)));
     assert!(!at(liu + 6.0 * 0.0035).pass && !at(liu - 6.0 * 0.0035).pass);
     assert!(at(liu + 3.0 * 0.0035).pass && at(liu - 3.0 * 0.0035).pass);
-    // No reference states its accuracy for dense disks, the metastable fluid of spheres or a
-    // crystal below melting.
+    // No reference states its accuracy for dense disks, the deeply metastable fluid of spheres
+    // or a crystal below melting.
     assert!(check_point(&point(2, Phase::Fluid, 0.7, 9.0, 0.01)).is_none());
-    assert!(check_point(&point(3, Phase::Fluid, 0.52, 15.0, 0.01)).is_none());
+    assert!(check_point(&point(3, Phase::Fluid, 0.55, 18.0, 0.01)).is_none());
     assert!(check_point(&point(3, Phase::Fcc, 0.5, 9.6, 0.01)).is_none());
+    // The metastable fluid must still be one: a state that froze (Q₆ of a crystal) fails; the
+    // check applies to spheres above freezing only.
+    let mut froze = point(3, Phase::Fluid, 0.52, z_hansen_goos(0.52), 0.01);
+    assert!(check_still_fluid(&froze).unwrap().pass);
+    froze.order = 0.45;
+    assert!(!check_still_fluid(&froze).unwrap().pass);
+    assert!(check_still_fluid(&point(3, Phase::Fluid, 0.45, 6.0, 0.01)).is_none());
+    assert!(check_still_fluid(&point(2, Phase::Fluid, 0.72, 9.0, 0.01)).is_none());
 }
 
 /// Every experiment in 3D (quick): its checks pass and it writes `<name>_3d/result.json` with
@@ -194,7 +209,9 @@ fn every_experiment_runs_in_three_dimensions() {
         if *name == "equation_of_state" {
             let points = json["data"]["points"].as_array().unwrap();
             let phases: Vec<&str> = points.iter().map(|p| p["phase"].as_str().unwrap()).collect();
-            assert_eq!(phases, ["fluid", "fluid", "fcc"]);
+            assert_eq!(phases, ["fluid", "fluid", "fluid", "fcc"]);
+            let starts: Vec<&str> = points.iter().map(|p| p["start"].as_str().unwrap()).collect();
+            assert_eq!(starts, ["lattice", "lattice", "compression", "lattice"]);
             for p in points {
                 for key in ["eta", "Z", "Z_err", "phase", "n_particles", "collisions"] {
                     assert!(p.get(key).is_some(), "a point lacks {key}");
@@ -352,4 +369,119 @@ fn equipartition_check_can_fail() {
     assert!(!check.pass, "{check:?}");
     let (_, check) = relax::<2>([0.5, 0.5], 400, 300.0, 1, "long").unwrap();
     assert!(check.pass, "{check:?}");
+}
+
+/// `jamming` (quick, disks): its checks pass, `result.json` holds the packings and the
+/// per-rate table, and its plots are drawn. (Spheres: `every_experiment_runs_in_three_dimensions`.)
+#[test]
+fn jamming_quick_passes_and_writes_its_packings() {
+    use collide::lab::jamming;
+    let dir = out("lab-jamming");
+    let options = Options { quick: true, seed: 1, out: dir.clone(), dimension: 2 };
+    let result = jamming::run(&options).unwrap();
+    result.write(&dir).unwrap();
+    assert!(result.passed(), "{}", collide::lab::check::table("jamming", &result.checks));
+    let plan = jamming::Plan::new(2, true);
+    let rates = result.data["rates"].as_array().unwrap();
+    assert_eq!(rates.len(), plan.rates.len());
+    for r in rates {
+        for key in ["rate", "phi_j", "phi_j_err", "phi_j_extrapolated", "contacts_per_particle", "excess_contacts", "unjammed"] {
+            assert!(r.get(key).is_some(), "a rate lacks {key}");
+        }
+    }
+    let packings = result.data["packings"].as_array().unwrap();
+    assert_eq!(packings.len(), plan.rates.len() * plan.seeds);
+    assert!(result.data["crystal"]["order"].as_f64().unwrap() > 0.5);
+    assert_svgs(&result, &dir);
+}
+
+/// A plausible set of 2D packings (rates 0.03, 0.01, 0.003; four seeds each) that passes
+/// every check of `jamming`, to be spoiled one way at a time.
+fn good_packings() -> (collide::lab::jamming::Plan, Vec<collide::lab::jamming::Packing>, collide::lab::jamming::Packing) {
+    use collide::lab::jamming::{Divergence, Packing, Plan};
+    let plan = Plan::new(2, true);
+    assert_eq!(plan.rates, [0.03, 0.01, 0.003]);
+    let packing = |rate: f64, seed: u64, phi_j: f64, missing: usize, drift: f64| Packing {
+        rate,
+        seed,
+        n: 200,
+        phi_j,
+        reduced_pressure: 1e12,
+        collisions: 1,
+        sim_time: 1.0,
+        max_overlap: 1e-14,
+        held: 180,
+        contacts: 2 * 179 + 1 - missing,
+        contact_tolerance: 2e-9,
+        order: 0.05,
+        divergence: Some(Divergence { phi_j: phi_j + drift, error: 1e-5, prefactor: 1.9, points: 500 }),
+        curve: Vec::new(),
+    };
+    let mut packings = Vec::new();
+    for (r, (&rate, (phi, missing))) in plan.rates.iter().zip([(0.838, 30), (0.8445, 13), (0.8455, 2)]).enumerate() {
+        for s in 0..4u64 {
+            let wiggle = [-1.0, 1.0, -0.5, 0.5][s as usize];
+            packings.push(packing(
+                rate,
+                s + 1,
+                phi + 0.0008 * wiggle,
+                (missing as f64 + 2.0 * wiggle).max(0.0) as usize,
+                1e-5 * wiggle * if r == 1 { -1.0 } else { 1.0 },
+            ));
+        }
+    }
+    let mut crystal = packing(0.003, 1, 0.864, 0, 0.0);
+    crystal.order = 0.82;
+    (plan, packings, crystal)
+}
+
+/// Every check of `jamming` passes on plausible packings and fails when they are wrong in
+/// its way: a jamming density 0.01 too high; no rate effect; a pressure that diverges
+/// 6·10⁻⁵ away from where the packing jams (six times the spread of the extrapolations); one
+/// contact too many; no approach to isostaticity; an uncrystallised slow packing; an ordered
+/// jammed packing; an overlap of 10⁻⁹.
+#[test]
+fn jamming_checks_can_fail() {
+    use collide::lab::jamming::checks;
+    let (plan, good, crystal) = good_packings();
+    let verdicts = |packings: &[collide::lab::jamming::Packing], crystal: &collide::lab::jamming::Packing| {
+        checks(2, &plan, packings, crystal).iter().map(|c| c.pass).collect::<Vec<_>>()
+    };
+    let all = verdicts(&good, &crystal);
+    assert_eq!(all, vec![true; 7], "{}", collide::lab::check::table("jamming", &checks(2, &plan, &good, &crystal)));
+    let failing_only = |k: usize, spoiled: Vec<bool>| {
+        let expected: Vec<bool> = (0..7).map(|i| i != k).collect();
+        assert_eq!(spoiled, expected, "spoiling check {k}");
+    };
+    let spoil = |f: &dyn Fn(&mut collide::lab::jamming::Packing)| {
+        let mut packings = good.clone();
+        packings.iter_mut().for_each(f);
+        packings
+    };
+    // 1: every density 0.01 higher shifts the reference rate's mean beyond its tolerance.
+    let shift = |p: &mut collide::lab::jamming::Packing, by: f64| {
+        p.phi_j += by;
+        p.divergence.as_mut().unwrap().phi_j += by;
+    };
+    failing_only(0, verdicts(&spoil(&|p| shift(p, 0.01)), &crystal));
+    // 2: the divergence 6·10⁻⁵ beyond the density reached.
+    failing_only(1, verdicts(&spoil(&|p| p.divergence.as_mut().unwrap().phi_j = p.phi_j + 6e-5), &crystal));
+    // 3: one contact beyond isostatic in one packing.
+    let mut extra = good.clone();
+    extra[11].contacts = 2 * 179 + 2;
+    failing_only(2, verdicts(&extra, &crystal));
+    // 4: the reference rate as close to isostatic as the slowest.
+    failing_only(3, verdicts(&spoil(&|p| if p.rate == 0.01 { p.contacts = 2 * 179 + 1 - 2 }), &crystal));
+    // 5: the slow monodisperse packing as disordered as the rest.
+    let mut glass = crystal.clone();
+    glass.order = 0.3;
+    failing_only(4, verdicts(&good, &glass));
+    // 6: an ordered "jammed" packing.
+    let mut ordered = good.clone();
+    ordered[0].order = 0.6;
+    failing_only(5, verdicts(&ordered, &crystal));
+    // 7: an overlap of 10⁻⁹.
+    let mut overlapping = good.clone();
+    overlapping[3].max_overlap = 1e-9;
+    failing_only(6, verdicts(&overlapping, &crystal));
 }

@@ -16,7 +16,8 @@ pub struct Check {
     pub expected: f64,
     /// The allowed |measured − expected| (or 0 for `at most` checks).
     pub tolerance: f64,
-    /// `"within"`: |measured − expected| ≤ tolerance; `"at most"`: measured ≤ expected.
+    /// `"within"`: |measured − expected| ≤ tolerance; `"at most"`: measured ≤ expected;
+    /// `"at least"`: measured ≥ expected.
     pub kind: String,
     /// Where the tolerance comes from.
     pub why: String,
@@ -46,14 +47,43 @@ impl Check {
         }
     }
 
-    /// Deviation in units of the tolerance (for tables): ≤ 1 passes.
-    pub fn score(&self) -> f64 {
-        if self.kind == "within" {
-            (self.measured - self.expected).abs() / self.tolerance
-        } else {
-            self.measured / self.expected
+    /// Passes when measured ≥ limit.
+    pub fn at_least(name: &str, measured: f64, error: f64, limit: f64, why: &str) -> Check {
+        let pass = measured >= limit;
+        Check {
+            name: name.into(),
+            measured,
+            error,
+            expected: limit,
+            tolerance: 0.0,
+            kind: "at least".into(),
+            why: why.into(),
+            pass,
         }
     }
+
+    /// The expectation as text: `expected ± tolerance`, `≤ limit` or `≥ limit`.
+    pub fn expectation(&self, digits: usize) -> String {
+        match self.kind.as_str() {
+            "within" => format!("{} ± {:.digits$e}", number(self.expected), self.tolerance),
+            "at least" => format!("≥ {}", number(self.expected)),
+            _ => format!("≤ {}", number(self.expected)),
+        }
+    }
+
+    /// Deviation in units of the tolerance (for tables): ≤ 1 passes.
+    pub fn score(&self) -> f64 {
+        match self.kind.as_str() {
+            "within" => (self.measured - self.expected).abs() / self.tolerance,
+            "at least" => self.expected / self.measured,
+            _ => self.measured / self.expected,
+        }
+    }
+}
+
+/// A number for a table: six decimals, or six significant digits when that would hide it.
+pub fn number(x: f64) -> String {
+    if x != 0.0 && x.abs() < 1e-3 { format!("{x:.5e}") } else { format!("{x:.6}") }
 }
 
 /// A plain-text verdict table.
@@ -62,12 +92,8 @@ pub fn table(experiment: &str, checks: &[Check]) -> String {
     writeln!(out, "{experiment}").unwrap();
     for c in checks {
         let verdict = if c.pass { "PASS" } else { "FAIL" };
-        let expectation = if c.kind == "within" {
-            format!("{:.6} ± {:.2e}", c.expected, c.tolerance)
-        } else {
-            format!("≤ {:.6}", c.expected)
-        };
-        writeln!(out, "  [{verdict}] {}: {:.6} (±{:.1e}) vs {expectation}", c.name, c.measured, c.error).unwrap();
+        let expectation = c.expectation(2);
+        writeln!(out, "  [{verdict}] {}: {} (±{:.1e}) vs {expectation}", c.name, number(c.measured), c.error).unwrap();
     }
     out
 }

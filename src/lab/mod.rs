@@ -21,6 +21,7 @@ pub mod check;
 pub mod collision_rate;
 pub mod equation_of_state;
 pub mod equipartition;
+pub mod jamming;
 pub mod maxwell_boltzmann;
 pub mod plot;
 pub mod report;
@@ -46,6 +47,7 @@ pub const EXPERIMENTS: &[(&str, Experiment)] = &[
     (equation_of_state::NAME, equation_of_state::run),
     (collision_rate::NAME, collision_rate::run),
     (equipartition::NAME, equipartition::run),
+    (jamming::NAME, jamming::run),
 ];
 
 /// Why an experiment could not finish (its checks failing is not an error: they are in the

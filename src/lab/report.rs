@@ -47,11 +47,7 @@ fn escape(s: &str) -> String {
 }
 
 fn expectation(c: &Check) -> String {
-    if c.kind == "within" {
-        format!("{:.6} ± {:.3e}", c.expected, c.tolerance)
-    } else {
-        format!("≤ {:.6}", c.expected)
-    }
+    c.expectation(3)
 }
 
 /// Writes `report.md` and `index.html` for these results into `options.out`.
@@ -104,9 +100,9 @@ pub fn write_report(results: &[ExperimentResult], options: &Options) -> Result<(
             let verdict = if c.pass { "PASS" } else { "FAIL" };
             writeln!(
                 md,
-                "| {} | {:.6} | {:.2e} | {} | {verdict} | {} |",
+                "| {} | {} | {:.2e} | {} | {verdict} | {} |",
                 c.name,
-                c.measured,
+                super::check::number(c.measured),
                 c.error,
                 expectation(c),
                 c.why
@@ -114,9 +110,9 @@ pub fn write_report(results: &[ExperimentResult], options: &Options) -> Result<(
             .unwrap();
             write!(
                 html,
-                "<tr><td>{}</td><td>{:.6}</td><td>{:.2e}</td><td>{}</td><td class=\"{}\">{verdict}</td><td>{}</td></tr>",
+                "<tr><td>{}</td><td>{}</td><td>{:.2e}</td><td>{}</td><td class=\"{}\">{verdict}</td><td>{}</td></tr>",
                 escape(&c.name),
-                c.measured,
+                super::check::number(c.measured),
                 c.error,
                 escape(&expectation(c)),
                 verdict.to_lowercase(),

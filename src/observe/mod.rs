@@ -11,7 +11,8 @@
 //! * The registered observables a configuration names under `[observe.<name>]`
 //!   ([`Selection`]): [`velocities`] (the velocity distribution against the Maxwellian).
 //! * [`contacts`]: the contact network of a dense state (contacts per particle, rattlers),
-//!   an analysis of one state rather than an observer of events.
+//!   an analysis of one state rather than an observer of events; likewise [`order`], its
+//!   bond-orientational order (Ψ₆ of disks, Q₆ of spheres: crystal or amorphous).
 //!   A run keeps them in its checkpoints and reports them in `summary.json`
 //!   (`"observables"`); an experiment can also build any observer itself and hand it to
 //!   [`Run::advance`](crate::run::Run::advance).
@@ -24,6 +25,7 @@
 
 pub mod blocks;
 pub mod contacts;
+pub mod order;
 pub mod thermo;
 pub mod velocities;
 
