@@ -215,23 +215,37 @@ fn polydisperse_size_asymmetric_small_and_walled_systems_compress() {
     let jam = "[init]\nplacement = \"random\"\n[compress]\nrate = 0.01\nuntil = \"jammed\"\n";
     let poly: Vec<(usize, f64, f64)> = (0..10).map(|k| (10, 0.4 + 0.2 * k as f64 / 9.0, 1.0)).collect();
     let cases = [
-        ("polydisperse disks", 2, format!("[box]\npacking_fraction = 0.5\nboundary = \"periodic\"\n{jam}{}", species(&poly)), 0.80..0.88),
+        (
+            "polydisperse disks",
+            2,
+            format!("[box]\npacking_fraction = 0.5\nboundary = \"periodic\"\n{jam}{}", species(&poly)),
+            0.80..0.88,
+        ),
         (
             "50 spheres, periodic",
             3,
-            format!("[box]\npacking_fraction = 0.3\nboundary = \"periodic\"\n{jam}pressure_limit = 1e4\n{}", species(&[(50, 0.5, 1.0)])),
+            format!(
+                "[box]\npacking_fraction = 0.3\nboundary = \"periodic\"\n{jam}pressure_limit = 1e4\n{}",
+                species(&[(50, 0.5, 1.0)])
+            ),
             0.60..0.68,
         ),
         (
             "50 disks between walls",
             2,
-            format!("[box]\npacking_fraction = 0.4\nboundary = \"wall\"\n{jam}{}", species(&[(25, 0.5, 1.0), (25, 0.7, 1.0)])),
+            format!(
+                "[box]\npacking_fraction = 0.4\nboundary = \"wall\"\n{jam}{}",
+                species(&[(25, 0.5, 1.0), (25, 0.7, 1.0)])
+            ),
             0.70..0.86,
         ),
         (
             "50 spheres between walls",
             3,
-            format!("[box]\npacking_fraction = 0.25\nboundary = \"wall\"\n{jam}{}", species(&[(25, 0.5, 1.0), (25, 0.7, 1.0)])),
+            format!(
+                "[box]\npacking_fraction = 0.25\nboundary = \"wall\"\n{jam}{}",
+                species(&[(25, 0.5, 1.0), (25, 0.7, 1.0)])
+            ),
             0.45..0.62,
         ),
     ];

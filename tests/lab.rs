@@ -385,7 +385,9 @@ fn jamming_quick_passes_and_writes_its_packings() {
     let rates = result.data["rates"].as_array().unwrap();
     assert_eq!(rates.len(), plan.rates.len());
     for r in rates {
-        for key in ["rate", "phi_j", "phi_j_err", "phi_j_extrapolated", "contacts_per_particle", "excess_contacts", "unjammed"] {
+        for key in
+            ["rate", "phi_j", "phi_j_err", "phi_j_extrapolated", "contacts_per_particle", "excess_contacts", "unjammed"]
+        {
             assert!(r.get(key).is_some(), "a rate lacks {key}");
         }
     }
@@ -397,7 +399,8 @@ fn jamming_quick_passes_and_writes_its_packings() {
 
 /// A plausible set of 2D packings (rates 0.03, 0.01, 0.003; four seeds each) that passes
 /// every check of `jamming`, to be spoiled one way at a time.
-fn good_packings() -> (collide::lab::jamming::Plan, Vec<collide::lab::jamming::Packing>, collide::lab::jamming::Packing) {
+fn good_packings() -> (collide::lab::jamming::Plan, Vec<collide::lab::jamming::Packing>, collide::lab::jamming::Packing)
+{
     use collide::lab::jamming::{Divergence, Packing, Plan};
     let plan = Plan::new(2, true);
     assert_eq!(plan.rates, [0.03, 0.01, 0.003]);
@@ -471,7 +474,17 @@ fn jamming_checks_can_fail() {
     extra[11].contacts = 2 * 179 + 2;
     failing_only(2, verdicts(&extra, &crystal));
     // 4: the reference rate as close to isostatic as the slowest.
-    failing_only(3, verdicts(&spoil(&|p| if p.rate == 0.01 { p.contacts = 2 * 179 + 1 - 2 }), &crystal));
+    failing_only(
+        3,
+        verdicts(
+            &spoil(&|p| {
+                if p.rate == 0.01 {
+                    p.contacts = 2 * 179 + 1 - 2
+                }
+            }),
+            &crystal,
+        ),
+    );
     // 5: the slow monodisperse packing as disordered as the rest.
     let mut glass = crystal.clone();
     glass.order = 0.3;

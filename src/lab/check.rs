@@ -34,29 +34,23 @@ impl Check {
 
     /// Passes when measured ≤ limit.
     pub fn at_most(name: &str, measured: f64, error: f64, limit: f64, why: &str) -> Check {
-        let pass = measured <= limit;
-        Check {
-            name: name.into(),
-            measured,
-            error,
-            expected: limit,
-            tolerance: 0.0,
-            kind: "at most".into(),
-            why: why.into(),
-            pass,
-        }
+        Check::bound(name, measured, error, limit, "at most", measured <= limit, why)
     }
 
     /// Passes when measured ≥ limit.
     pub fn at_least(name: &str, measured: f64, error: f64, limit: f64, why: &str) -> Check {
-        let pass = measured >= limit;
+        Check::bound(name, measured, error, limit, "at least", measured >= limit, why)
+    }
+
+    /// A one-sided check against `limit` (no tolerance).
+    fn bound(name: &str, measured: f64, error: f64, limit: f64, kind: &str, pass: bool, why: &str) -> Check {
         Check {
             name: name.into(),
             measured,
             error,
             expected: limit,
             tolerance: 0.0,
-            kind: "at least".into(),
+            kind: kind.into(),
             why: why.into(),
             pass,
         }

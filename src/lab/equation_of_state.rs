@@ -251,8 +251,10 @@ fn states(d: usize, quick: bool) -> Vec<(Phase, Start, f64, usize)> {
     };
     use Start::{Compression, Lattice};
     match (d, quick) {
-        (2, true) => [with(Phase::Fluid, Lattice, 256, &[0.1, 0.3, 0.5, 0.65]), with(Phase::Fluid, Compression, 256, &[0.7])]
-            .concat(),
+        (2, true) => {
+            [with(Phase::Fluid, Lattice, 256, &[0.1, 0.3, 0.5, 0.65]), with(Phase::Fluid, Compression, 256, &[0.7])]
+                .concat()
+        }
         (2, false) => [
             with(
                 Phase::Fluid,
@@ -296,8 +298,7 @@ pub fn run(options: &Options) -> Result<ExperimentResult, ExperimentError> {
         } * n as u64;
         points.push(measure(d, phase, start, eta, n, equilibration, per_particle * n as u64, options.seed + k as u64)?);
     }
-    let checks: Vec<Check> =
-        points.iter().flat_map(|p| [check_point(p), check_still_fluid(p)]).flatten().collect();
+    let checks: Vec<Check> = points.iter().flat_map(|p| [check_point(p), check_still_fluid(p)]).flatten().collect();
 
     let dir = options.plot_dir(NAME)?;
     let curve = |f: &dyn Fn(f64) -> f64, from: f64, to: f64| {

@@ -95,47 +95,30 @@ pub struct Plan {
 impl Plan {
     /// The plan for dimension `d`.
     pub fn new(d: usize, quick: bool) -> Plan {
-        match (d, quick) {
-            (2, true) => Plan {
-                n: 200,
+        // Only the size and the number of seeds differ between quick and report size.
+        let seeds = if quick { 4 } else { 8 };
+        if d == 2 {
+            Plan {
+                n: if quick { 200 } else { 400 },
                 rates: vec![0.03, 0.01, 0.003],
                 reference_rate: 1,
-                seeds: 4,
+                seeds,
                 start: 0.5,
                 crystal_n: 100,
                 crystal_rate: 0.003,
                 crystal_start: 0.5,
-            },
-            (2, false) => Plan {
-                n: 400,
-                rates: vec![0.03, 0.01, 0.003],
-                reference_rate: 1,
-                seeds: 8,
-                start: 0.5,
-                crystal_n: 100,
-                crystal_rate: 0.003,
-                crystal_start: 0.5,
-            },
-            (_, true) => Plan {
+            }
+        } else {
+            Plan {
                 n: 256,
                 rates: vec![0.03, 0.01],
                 reference_rate: 0,
-                seeds: 4,
+                seeds,
                 start: 0.3,
                 crystal_n: 108,
                 crystal_rate: 0.001,
                 crystal_start: 0.3,
-            },
-            (_, false) => Plan {
-                n: 256,
-                rates: vec![0.03, 0.01],
-                reference_rate: 0,
-                seeds: 8,
-                start: 0.3,
-                crystal_n: 108,
-                crystal_rate: 0.001,
-                crystal_start: 0.3,
-            },
+            }
         }
     }
 }
@@ -263,16 +246,14 @@ pub fn compress<const D: usize>(
     let network = contacts(&run.sim, tolerance);
     let in_range: Vec<(f64, f64)> =
         windows.points.iter().filter(|p| p.1 >= FIT_RANGE.0 && p.1 <= FIT_RANGE.1).copied().collect();
-    let divergence = line_root_with_error(
-        &in_range.iter().map(|&(phi, z)| (phi, 1.0 / z)).collect::<Vec<_>>(),
-        JACKKNIFE_BLOCKS,
-    )
-    .map(|(line, phi_j, error)| Divergence {
-        phi_j,
-        error,
-        prefactor: -1.0 / (line.slope * phi_j),
-        points: line.points,
-    });
+    let divergence =
+        line_root_with_error(&in_range.iter().map(|&(phi, z)| (phi, 1.0 / z)).collect::<Vec<_>>(), JACKKNIFE_BLOCKS)
+            .map(|(line, phi_j, error)| Divergence {
+                phi_j,
+                error,
+                prefactor: -1.0 / (line.slope * phi_j),
+                points: line.points,
+            });
     let stride = in_range.len().div_ceil(200).max(1);
     Ok(Packing {
         rate,

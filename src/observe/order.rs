@@ -131,7 +131,8 @@ mod tests {
             hcp.push(SVector::<f64, 3>::new(rho * a.cos(), rho * a.sin(), -h));
         }
         assert!((order_of(&hcp) - 0.48476).abs() < 1e-4, "{}", order_of(&hcp));
-        let triangular: Vec<_> = (0..6).map(|k| v2((k as f64 * 1.0471975511965976).cos(), (k as f64 * 1.0471975511965976).sin())).collect();
+        let triangular: Vec<_> =
+            (0..6).map(|k| v2((k as f64 * 1.0471975511965976).cos(), (k as f64 * 1.0471975511965976).sin())).collect();
         assert!((order_of(&triangular) - 1.0).abs() < 1e-12);
         let square = [v2(1.0, 0.0), v2(0.0, 1.0)];
         assert!(order_of(&square) < 1e-12);
