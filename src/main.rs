@@ -106,9 +106,13 @@ struct ExperimentArgs {
 
 #[derive(Args)]
 struct ValidateArgs {
-    /// CI-sized experiments (seconds) instead of report quality (about eight minutes).
+    /// CI-sized experiments (seconds) instead of report quality (minutes).
     #[arg(long)]
     quick: bool,
+    /// Experiments run at once (default: the number of cores); the results do not depend
+    /// on it.
+    #[arg(long, value_parser = clap::value_parser!(u32).range(1..=1024))]
+    jobs: Option<u32>,
     /// Seed of the initial states.
     #[arg(long, default_value_t = 1)]
     seed: u64,
@@ -119,7 +123,7 @@ struct ValidateArgs {
 
 impl Default for ValidateArgs {
     fn default() -> Self {
-        ValidateArgs { quick: false, seed: 1, out: PathBuf::from("validation") }
+        ValidateArgs { quick: false, jobs: None, seed: 1, out: PathBuf::from("validation") }
     }
 }
 
@@ -543,7 +547,9 @@ fn run_simulation(args: RunArgs) -> Result<ExitCode> {
 fn validate(args: ValidateArgs) -> Result<ExitCode> {
     use collide::lab::{Options, check::table, report::validate};
     let options = Options { quick: args.quick, seed: args.seed, out: args.out, dimension: 2 };
-    let results = validate(&options, |name| eprintln!("running {name} …"))?;
+    let cores = std::thread::available_parallelism().map_or(1, |n| n.get());
+    let jobs = args.jobs.map_or(cores, |j| j as usize);
+    let results = validate(&options, jobs, |name| eprintln!("running {name} …"))?;
     for r in &results {
         say!("{}", table(&r.slug(), &r.checks).trim_end());
     }

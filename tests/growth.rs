@@ -3,7 +3,10 @@
 //! target packing fraction; the thermostat; checkpoints; the errors.
 
 use collide::engine::init::{Placement, Species, Velocities, box_for_packing_fraction, initial_particles};
-use collide::engine::{Boundary, Ending, Outcome, Particle, ReferenceSimulation, SimBox, Simulation, SimulationState};
+use collide::engine::{
+    Boundary, Ending, GROWTH_STRETCH, Neighbourhood, Outcome, Particle, ReferenceSimulation, SimBox, Simulation,
+    SimulationState,
+};
 
 mod common;
 use common::assert_same_collisions;
@@ -72,6 +75,62 @@ fn a_compression_collides_as_the_growing_reference_says() {
     }
 }
 
+/// The neighbourhood adapts as the radii grow: it is rebuilt for each stretch of
+/// [`GROWTH_STRETCH`] — lists or the grid, as asked — and the collisions are still the
+/// growing reference's, bit for bit, through every rebuild to the end of the growth. The
+/// number of stretches is the one the growth law gives (`⌈ln(final/initial radius) /
+/// ln(stretch)⌉`, one more where rounding lands a stretch's end a hair short), so a
+/// neighbourhood sized once for the final radii (one stretch) would fail here.
+#[test]
+fn the_neighbourhood_adapts_as_the_radii_grow_and_the_collisions_do_not_change() {
+    fn compare<const D: usize>(species: &[Species], eta: f64, target: f64, choice: Neighbourhood, label: &str) {
+        let (particles, sim_box) = system(species, eta, [Boundary::Periodic; D], 7);
+        let mut fast = Simulation::with_neighbourhood(particles.clone(), sim_box, choice).unwrap();
+        fast.grow_to(target, 0.1, 1.0, 40).unwrap();
+        let until = fast.growth().unwrap().until;
+        let mut slow = ReferenceSimulation::new(particles, sim_box);
+        slow.grow(0.1, until, 1.0, 40).unwrap();
+        let mut stretches = vec![fast.state().neighbourhood_until.unwrap()];
+        let mut listed = 0;
+        let mut k = 0;
+        while fast.growth().is_some() {
+            let outcome = fast.step().expect("an event");
+            let state_until = fast.growth().map(|_| fast.state().neighbourhood_until.unwrap());
+            if let Some(t) = state_until
+                && t != *stretches.last().unwrap()
+            {
+                assert!(t > *stretches.last().unwrap(), "{label}: the stretches end later and later");
+                stretches.push(t);
+                listed += !fast.state().centres.is_empty() as usize;
+            }
+            let Some((i, j)) = outcome.collided() else { continue };
+            let expected = slow.step().expect("a collision");
+            assert_eq!(
+                (fast.time().to_bits(), i, j),
+                (expected.0.to_bits(), expected.1, expected.2),
+                "{label}, collision {k}"
+            );
+            k += 1;
+        }
+        let growth = (target / eta).powf(1.0 / D as f64);
+        let expected = (growth.ln() / GROWTH_STRETCH.ln()).ceil() as usize;
+        assert!(
+            stretches.len() == expected || stretches.len() == expected + 1,
+            "{label}: {} stretches for a growth by {growth}, {expected} expected",
+            stretches.len()
+        );
+        assert_eq!(*stretches.last().unwrap(), until, "{label}: the last stretch ends with the growth");
+        match choice {
+            Neighbourhood::Lists => assert_eq!(listed, stretches.len() - 1, "{label}: lists in every stretch"),
+            _ => assert_eq!(listed, 0, "{label}: the grid in every stretch"),
+        }
+        assert!(k > 1000, "{label}: only {k} collisions");
+    }
+    compare::<2>(&one(120), 0.2, 0.7, Neighbourhood::Lists, "disks, lists");
+    compare::<2>(&two(120, 1.4), 0.2, 0.7, Neighbourhood::Grid, "mixed disks, grid");
+    compare::<3>(&one(150), 0.15, 0.45, Neighbourhood::Lists, "spheres, lists");
+}
+
 /// The comparison above passes through the end of the growth: here the same runs stop just
 /// after it and both engines hold the same particles, to the bit, with the radii frozen at
 /// the target packing fraction (to rounding), no overlap beyond rounding, and kT within the
@@ -123,16 +182,35 @@ fn a_compression_resumes_bit_identically_from_its_checkpoint() {
     assert!(whole.growth().is_some(), "the checkpoint must fall inside the growth");
     let text = serde_json::to_string(&whole.state()).unwrap();
     let state: SimulationState<2> = serde_json::from_str(&text).unwrap();
-    assert!(state.growth.is_some());
+    assert!(state.growth.is_some() && state.neighbourhood_until.is_some());
+    // A checkpoint written before the neighbourhood adapted (no `neighbourhood_until`, the
+    // grid) resumes too, with the grid sized for the final radii: the same collisions.
+    let mut old = state.clone();
+    old.neighbourhood_until = None;
+    assert!(old.centres.is_empty(), "this run keeps the grid");
     let mut resumed = Simulation::restore(state, sim_box).unwrap();
+    let mut resumed_old = Simulation::restore(old, sim_box).unwrap();
     let mut ended = false;
+    let mut collisions = Vec::new();
     for k in 0..4000 {
         let (a, b) = (whole.step().unwrap(), resumed.step().unwrap());
         assert_eq!((whole.time().to_bits(), a.collided()), (resumed.time().to_bits(), b.collided()), "event {k}");
         ended |= a == Outcome::GrowthEnd;
+        if let Some(pair) = a.collided() {
+            collisions.push((whole.time().to_bits(), pair));
+        }
     }
     assert!(ended, "the growth should end within the comparison");
     assert_eq!(whole.particles(), resumed.particles());
+    // The old checkpoint's run has other cell crossings, and the same collisions.
+    for (k, expected) in collisions.iter().enumerate() {
+        let pair = loop {
+            if let Some(pair) = resumed_old.step().unwrap().collided() {
+                break pair;
+            }
+        };
+        assert_eq!((resumed_old.time().to_bits(), pair), *expected, "collision {k} after the old checkpoint");
+    }
 }
 
 /// Small systems, walls and a 1 : 10 size ratio compress without trouble: periodic axes too

@@ -1,17 +1,43 @@
 //! The experiments: their quick versions pass, their plots hold what they should, and every
 //! check is able to fail when fed data that is physically wrong.
 
-use collide::lab::maxwell_boltzmann::{self, Metrics, checks, metrics, reduced};
+use collide::lab::maxwell_boltzmann::{Metrics, checks, metrics, reduced};
 use collide::lab::{ExperimentResult, Options};
 use rand::rngs::Xoshiro256PlusPlus;
 use rand::{RngExt, SeedableRng};
 use rand_distr::{Distribution, Normal};
-use std::path::Path;
+use std::path::{Path, PathBuf};
+use std::sync::OnceLock;
 
 fn out(name: &str) -> std::path::PathBuf {
     let dir = Path::new(env!("CARGO_TARGET_TMPDIR")).join(name);
     let _ = std::fs::remove_dir_all(&dir);
     dir
+}
+
+/// `collide validate --quick --seed 1 --jobs 2`, run once for every test here that looks at
+/// the quick experiments (each experiment runs once): its directory, and its exit status and
+/// output.
+fn quick_validation() -> &'static (PathBuf, std::process::Output) {
+    static RUN: OnceLock<(PathBuf, std::process::Output)> = OnceLock::new();
+    RUN.get_or_init(|| {
+        let dir = out("lab-validate");
+        let output = std::process::Command::new(env!("CARGO_BIN_EXE_collide"))
+            .args(["validate", "--quick", "--seed", "1", "--jobs", "2", "--out", dir.to_str().unwrap()])
+            .output()
+            .expect("collide validate starts");
+        (dir, output)
+    })
+}
+
+/// The quick result of the experiment in directory `slug` (`name`, or `name_3d`), and the
+/// directory its own directory is in.
+fn quick(slug: &str) -> (ExperimentResult, &'static Path) {
+    let (dir, output) = quick_validation();
+    let text = std::fs::read_to_string(dir.join(slug).join("result.json")).unwrap_or_else(|e| {
+        panic!("{slug}/result.json: {e}; collide validate said:\n{}", String::from_utf8_lossy(&output.stderr))
+    });
+    (serde_json::from_str(&text).unwrap(), dir)
 }
 
 fn assert_svgs(result: &ExperimentResult, dir: &Path) {
@@ -29,10 +55,7 @@ fn assert_svgs(result: &ExperimentResult, dir: &Path) {
 
 #[test]
 fn maxwell_boltzmann_quick_passes_and_writes_its_outputs() {
-    let dir = out("lab-mb");
-    let options = Options { quick: true, seed: 1, out: dir.clone(), dimension: 2 };
-    let result = maxwell_boltzmann::run(&options).unwrap();
-    result.write(&dir).unwrap();
+    let (result, dir) = quick("maxwell_boltzmann");
     assert!(result.passed(), "{}", collide::lab::check::table("maxwell_boltzmann", &result.checks));
     let json: serde_json::Value =
         serde_json::from_str(&std::fs::read_to_string(dir.join("maxwell_boltzmann/result.json")).unwrap()).unwrap();
@@ -44,7 +67,7 @@ fn maxwell_boltzmann_quick_passes_and_writes_its_outputs() {
             assert!(c.get(key).is_some(), "a check lacks {key}");
         }
     }
-    assert_svgs(&result, &dir);
+    assert_svgs(&result, dir);
 }
 
 fn gaussian_velocities(n: usize, seed: u64) -> Vec<[f64; 2]> {
@@ -97,10 +120,7 @@ fn maxwell_boltzmann_checks_can_fail() {
 
 #[test]
 fn equation_of_state_quick_passes_and_writes_points() {
-    use collide::lab::equation_of_state;
-    let dir = out("lab-eos");
-    let result = equation_of_state::run(&Options { quick: true, seed: 1, out: dir.clone(), dimension: 2 }).unwrap();
-    result.write(&dir).unwrap();
+    let (result, dir) = quick("equation_of_state");
     assert!(result.passed(), "{}", collide::lab::check::table("equation_of_state", &result.checks));
     assert!(result.checks.len() >= 3);
     let json: serde_json::Value =
@@ -114,7 +134,7 @@ fn equation_of_state_quick_passes_and_writes_points() {
             assert!(p.get(key).is_some(), "a point lacks {key}");
         }
     }
-    assert_svgs(&result, &dir);
+    assert_svgs(&result, dir);
 }
 
 /// The reference equations of state at known points, and checks failing for a pressure
@@ -193,10 +213,8 @@ fn equation_of_state_references_and_checks_can_fail() {
 /// the layout of 2D, and its plots.
 #[test]
 fn every_experiment_runs_in_three_dimensions() {
-    for (name, experiment) in collide::lab::EXPERIMENTS {
-        let dir = out(&format!("lab3-{name}"));
-        let result = experiment(&Options { quick: true, seed: 1, out: dir.clone(), dimension: 3 }).unwrap();
-        result.write(&dir).unwrap();
+    for (name, _) in collide::lab::EXPERIMENTS {
+        let (result, dir) = quick(&format!("{name}_3d"));
         assert!(result.passed(), "{}", collide::lab::check::table(&result.slug(), &result.checks));
         let json: serde_json::Value =
             serde_json::from_str(&std::fs::read_to_string(dir.join(format!("{name}_3d/result.json"))).unwrap())
@@ -218,7 +236,7 @@ fn every_experiment_runs_in_three_dimensions() {
                 }
             }
         }
-        assert_svgs(&result, &dir);
+        assert_svgs(&result, dir);
     }
 }
 
@@ -226,11 +244,7 @@ fn every_experiment_runs_in_three_dimensions() {
 /// report with the verdicts, the machine, the version and the seed; exit status 0.
 #[test]
 fn validate_writes_the_report() {
-    let dir = out("lab-validate");
-    let result = std::process::Command::new(env!("CARGO_BIN_EXE_collide"))
-        .args(["validate", "--quick", "--seed", "3", "--out", dir.to_str().unwrap()])
-        .output()
-        .unwrap();
+    let (dir, result) = quick_validation();
     assert!(result.status.success(), "{}", String::from_utf8_lossy(&result.stderr));
     let html = std::fs::read_to_string(dir.join("index.html")).unwrap();
     let md = std::fs::read_to_string(dir.join("report.md")).unwrap();
@@ -241,19 +255,22 @@ fn validate_writes_the_report() {
         }
     }
     assert!(html.matches("<svg").count() >= 12, "plots are inlined");
-    assert!(md.contains("seed 3") && md.contains(env!("CARGO_PKG_VERSION")) && md.contains("cores"));
+    assert!(md.contains("seed 1") && md.contains(env!("CARGO_PKG_VERSION")) && md.contains("cores"));
     assert!(md.contains("ALL CHECKS PASS") && !md.contains("| FAIL |"));
+    // Two at a time, the experiments give what each gives alone, to the bit.
+    let (threaded, _) = quick("equipartition");
+    let alone =
+        collide::lab::equipartition::run(&Options { quick: true, seed: 1, out: out("lab-alone"), dimension: 2 })
+            .unwrap();
+    assert_eq!(serde_json::to_string(&threaded).unwrap(), serde_json::to_string(&alone).unwrap());
 }
 
 #[test]
 fn wall_pressure_quick_passes() {
-    use collide::lab::wall_pressure;
-    let dir = out("lab-wall");
-    let result = wall_pressure::run(&Options { quick: true, seed: 1, out: dir.clone(), dimension: 2 }).unwrap();
-    result.write(&dir).unwrap();
+    let (result, dir) = quick("wall_pressure");
     assert!(result.passed(), "{}", collide::lab::check::table("wall_pressure", &result.checks));
     assert!(result.checks.len() >= 4);
-    assert_svgs(&result, &dir);
+    assert_svgs(&result, dir);
 }
 
 #[test]
@@ -314,15 +331,10 @@ fn wall_pressure_checks_can_fail() {
 #[test]
 fn collision_rate_and_equipartition_quick_pass() {
     use collide::lab::{collision_rate, equipartition};
-    for (name, experiment) in [
-        (collision_rate::NAME, collision_rate::run as collide::lab::Experiment),
-        (equipartition::NAME, equipartition::run),
-    ] {
-        let dir = out(&format!("lab-{name}"));
-        let result = experiment(&Options { quick: true, seed: 1, out: dir.clone(), dimension: 2 }).unwrap();
-        result.write(&dir).unwrap();
+    for name in [collision_rate::NAME, equipartition::NAME] {
+        let (result, dir) = quick(name);
         assert!(result.passed(), "{}", collide::lab::check::table(name, &result.checks));
-        assert_svgs(&result, &dir);
+        assert_svgs(&result, dir);
     }
 }
 
@@ -376,10 +388,7 @@ fn equipartition_check_can_fail() {
 #[test]
 fn jamming_quick_passes_and_writes_its_packings() {
     use collide::lab::jamming;
-    let dir = out("lab-jamming");
-    let options = Options { quick: true, seed: 1, out: dir.clone(), dimension: 2 };
-    let result = jamming::run(&options).unwrap();
-    result.write(&dir).unwrap();
+    let (result, dir) = quick("jamming");
     assert!(result.passed(), "{}", collide::lab::check::table("jamming", &result.checks));
     let plan = jamming::Plan::new(2, true);
     let rates = result.data["rates"].as_array().unwrap();
@@ -394,7 +403,7 @@ fn jamming_quick_passes_and_writes_its_packings() {
     let packings = result.data["packings"].as_array().unwrap();
     assert_eq!(packings.len(), plan.rates.len() * plan.seeds);
     assert!(result.data["crystal"]["order"].as_f64().unwrap() > 0.5);
-    assert_svgs(&result, &dir);
+    assert_svgs(&result, dir);
 }
 
 /// A plausible set of 2D packings (rates 0.03, 0.01, 0.003; four seeds each) that passes

@@ -40,7 +40,9 @@ pub(crate) mod timing;
 pub use collision::{Body, Impulse, Restitution, RestitutionError, resolve_growing_pair, resolve_pair};
 pub use geometry::{Boundary, Particle, SimBox};
 pub use motion::Radii;
-pub use neighbours::{LISTS_FROM, LISTS_FROM_3D, Neighbourhood, RANGE_HOLDS, RANGE_HOLDS_3D, UnknownNeighbourhood};
+pub use neighbours::{
+    GROWTH_STRETCH, LISTS_FROM, LISTS_FROM_3D, Neighbourhood, RANGE_HOLDS, RANGE_HOLDS_3D, UnknownNeighbourhood,
+};
 pub use params::{EngineParams, QueueChoice, Switch};
 pub use reference::ReferenceSimulation;
 pub use setup::{OverlapAudit, SetupError, check_box};

@@ -24,7 +24,7 @@ use super::arrays::Store;
 use super::collision::Restitution;
 use super::geometry::{Boundary, Particle, SimBox};
 use super::motion::Radii;
-use super::neighbours::{Neighbourhood, Neighbours, Saved};
+use super::neighbours::{GROWTH_STRETCH, Neighbourhood, Neighbours, Saved};
 use super::params::EngineParams;
 use super::queue::{EventQueue, QueueKind};
 use super::search::{NEAR, Search};
@@ -55,6 +55,9 @@ pub struct Simulation<const D: usize> {
     growth: Option<Growth>,
     /// How the last growth ended (none yet: `None`).
     ending: Option<Ending>,
+    /// While growing: until when the neighbourhood holds the radii (the end of its present
+    /// stretch, [`GROWTH_STRETCH`]; the growth's `until` for the last one).
+    holds_until: Option<f64>,
     search: Search<D>,
     timing: Timing,
 }
@@ -92,6 +95,10 @@ pub struct SimulationState<const D: usize> {
     /// A compression under way (absent when none).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub growth: Option<Growth>,
+    /// During a compression: until when the neighbourhood holds the radii (absent: until the
+    /// growth's end, with the cell grid).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub neighbourhood_until: Option<f64>,
 }
 
 impl<const D: usize> Simulation<D> {
@@ -142,6 +149,7 @@ impl<const D: usize> Simulation<D> {
             sampling: Sampling::default(),
             growth: None,
             ending: None,
+            holds_until: None,
             search: Search::new(batch),
             timing,
         };
@@ -156,11 +164,12 @@ impl<const D: usize> Simulation<D> {
     /// `every` pair collisions. The packing fraction at `until` is
     /// `φ(now)·(1 + rate·(until − now))^d`.
     ///
-    /// While the radii grow the neighbourhood is the cell grid, sized for the final radii
-    /// (the box must hold them: a periodic edge at least two final diameters, an edge
-    /// between walls longer than one), and pairs are searched one at a time with the growing
-    /// kernel. At `until` the step reports [`Outcome::GrowthEnd`] and the engine goes back to
-    /// its usual neighbourhood.
+    /// The box must hold the final radii (a periodic edge at least two final diameters, an
+    /// edge between walls longer than one). While the radii grow, the neighbourhood adapts:
+    /// it is built for radii [`GROWTH_STRETCH`] times the present ones and rebuilt when they
+    /// get there (lists or the grid, as without growth), and pairs are searched one at a
+    /// time with the growing kernel. At `until` the step reports [`Outcome::GrowthEnd`] and
+    /// the engine goes back to its usual neighbourhood.
     pub fn grow(&mut self, rate: f64, until: f64, kt: f64, every: u64) -> Result<(), SetupError> {
         if self.growth.is_some() {
             return Err(SetupError::Growth { what: "a growth is already under way".into() });
@@ -233,19 +242,28 @@ impl<const D: usize> Simulation<D> {
         volume / self.sim_box.volume()
     }
 
-    /// The neighbourhood, the short axes and the search for the present radii: while growing
-    /// the grid sized for the final radii and the scalar search; otherwise what the
-    /// parameters ask for. The pending events must be predicted again afterwards.
+    /// The neighbourhood, the short axes and the search for the present radii, what the
+    /// parameters ask for: while growing, built for the radii at the end of the next stretch
+    /// (until they are [`GROWTH_STRETCH`] times the present ones), with the scalar search.
+    /// The pending events must be predicted again afterwards.
     fn arrange_neighbourhood(&mut self) {
         let (reach, growing) = match &self.growth {
-            Some(g) => (2.0 * g.final_radius(&self.particles), true),
-            None => (2.0 * self.particles.iter().map(|p| p.radius).fold(0.0, f64::max), false),
+            Some(g) => {
+                let end = g.grown_by(self.time, GROWTH_STRETCH);
+                self.holds_until = Some(end);
+                (2.0 * g.largest_radius(&self.particles, end), true)
+            }
+            None => {
+                self.holds_until = None;
+                (2.0 * self.particles.iter().map(|p| p.radius).fold(0.0, f64::max), false)
+            }
         };
         self.short = pair::short_axes(&self.sim_box, reach);
-        let batch = !self.short.contains(&true) && !growing;
+        let lists = !self.short.contains(&true);
+        let batch = lists && !growing;
         let store = self.timing.store();
         let (sim_box, time, choice) = (&self.sim_box, self.time, self.params.neighbourhood);
-        self.neighbours = Neighbours::new(sim_box, reach, &self.particles, time, batch, choice, &store);
+        self.neighbours = Neighbours::new(sim_box, reach, &self.particles, time, lists, choice, &store);
         self.search = Search::new(batch);
     }
 
@@ -253,16 +271,27 @@ impl<const D: usize> Simulation<D> {
     /// choices but the neighbourhood it was saved with.
     pub fn restore(state: SimulationState<D>, sim_box: SimBox<D>) -> Result<Self, SetupError> {
         let mut reach = validate(&state.particles, &sim_box)?;
+        // A growth saved without the end of its stretch kept the grid for the final radii.
+        let mut lists_allowed = true;
+        let mut holds_until = None;
         if let Some(g) = &state.growth {
+            let holds = state.neighbourhood_until.unwrap_or(g.until);
             let fine = Growth::new(g.rate, g.origin, g.until, g.kt, g.every).is_ok()
                 && g.origin <= state.time
-                && state.time <= g.until
-                && state.centres.is_empty();
+                && state.time <= holds
+                && holds <= g.until
+                && (state.neighbourhood_until.is_some() || state.centres.is_empty());
             if !fine {
-                return Err(SetupError::BadState { what: format!("growth {g:?} with the clock at {}", state.time) });
+                return Err(SetupError::BadState {
+                    what: format!("growth {g:?} with the neighbourhood until {holds} and the clock at {}", state.time),
+                });
             }
-            reach = 2.0 * g.final_radius(&state.particles);
-            check_box(&sim_box, reach)?;
+            check_box(&sim_box, 2.0 * g.final_radius(&state.particles))?;
+            reach = 2.0 * g.largest_radius(&state.particles, holds);
+            lists_allowed = state.neighbourhood_until.is_some();
+            holds_until = Some(holds);
+        } else if state.neighbourhood_until.is_some() {
+            return Err(SetupError::BadState { what: "a neighbourhood stretch without a growth".into() });
         }
         let n = state.particles.len();
         let bad = |what: String| Err(SetupError::BadState { what });
@@ -304,12 +333,13 @@ impl<const D: usize> Simulation<D> {
             Saved::Centres(state.centres.iter().map(|c| SVector::from_column_slice(c)).collect(), state.crowded)
         };
         let short = pair::short_axes(&sim_box, reach);
-        let batch = !short.contains(&true) && state.growth.is_none();
+        let lists = !short.contains(&true) && lists_allowed;
+        let batch = lists && state.growth.is_none();
         let params = EngineParams::with_neighbourhood(state.neighbourhood);
         let timing = Timing::new(&params, n);
         let store = timing.store();
         let particles = store.moved(state.particles);
-        let neighbours = match Neighbours::restore(&sim_box, reach, n, batch, state.neighbourhood, saved, &store) {
+        let neighbours = match Neighbours::restore(&sim_box, reach, n, lists, state.neighbourhood, saved, &store) {
             Ok(neighbours) => neighbours,
             Err(what) => return bad(what),
         };
@@ -340,6 +370,7 @@ impl<const D: usize> Simulation<D> {
             sampling,
             growth: state.growth,
             ending: None,
+            holds_until,
         };
         sim.refuse_overlaps(RESTORE_OVERLAP)?;
         sim.check_pending().map_err(|what| SetupError::BadState { what })?;
@@ -418,6 +449,7 @@ impl<const D: usize> Simulation<D> {
             sampling: self.sampling.interval,
             next_sample: self.sampling.next,
             growth: self.growth,
+            neighbourhood_until: self.holds_until,
         }
     }
 
@@ -628,6 +660,19 @@ impl<const D: usize> Simulation<D> {
             if ends_first && let Some(growth) = &self.growth {
                 self.finish_growth(growth.predict(), Ending::Reached);
                 return Some(Outcome::GrowthEnd);
+            }
+            if let Some(t) = self.holds_until
+                && end.is_some_and(|end| t < end.time)
+                && t <= next.time
+                && self.sampling.predict().is_none_or(|sample| t <= sample)
+            {
+                // The radii have grown as far as the neighbourhood holds: rebuilt for the next
+                // stretch. No particle changes, so no event is reported; the pending events
+                // are predicted again against the new neighbourhood (the same events).
+                self.time = t;
+                self.arrange_neighbourhood();
+                self.predict_everyone();
+                continue;
             }
             if next.kind == EventKind::Nothing {
                 return None;

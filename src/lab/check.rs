@@ -10,7 +10,9 @@ pub struct Check {
     pub name: String,
     /// The measured value.
     pub measured: f64,
-    /// Its statistical error (one standard error; NaN when not applicable).
+    /// Its statistical error (one standard error; NaN when not applicable, written as
+    /// `null` in result.json since JSON has no NaN, and read back as NaN).
+    #[serde(deserialize_with = "nan_when_null")]
     pub error: f64,
     /// The expected value (or the limit, for `at most` checks).
     pub expected: f64,
@@ -23,6 +25,12 @@ pub struct Check {
     pub why: String,
     /// The verdict.
     pub pass: bool,
+}
+
+/// JSON writes a NaN as `null`; reading it back gives the NaN again, so a result.json
+/// round-trips to the same checks.
+fn nan_when_null<'de, D: serde::Deserializer<'de>>(d: D) -> Result<f64, D::Error> {
+    Ok(Option::<f64>::deserialize(d)?.unwrap_or(f64::NAN))
 }
 
 impl Check {

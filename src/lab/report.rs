@@ -139,18 +139,46 @@ pub fn write_report(results: &[ExperimentResult], options: &Options) -> Result<(
 }
 
 /// Runs the numerics check and every experiment in both dimensions (disks, then spheres),
-/// writes their results and the report, and returns the results (`progress` hears each
-/// experiment's directory name as it starts).
-pub fn validate(options: &Options, mut progress: impl FnMut(&str)) -> Result<Vec<ExperimentResult>, ExperimentError> {
-    let mut results = vec![numerics(options)];
-    for dimension in [2, 3] {
-        let options = Options { dimension, ..options.clone() };
-        for (name, experiment) in EXPERIMENTS {
-            progress(&options.slug(name));
-            let result = experiment(&options)?;
-            result.write(&options.out)?;
-            results.push(result);
+/// `jobs` experiments at a time (each is single-threaded but `jamming`, and independent of
+/// the others: the results are the same for any `jobs`, in the same order), writes their
+/// results and the report, and returns the results (`progress` hears each experiment's
+/// directory name as it starts). The first error, in that order, is returned once every
+/// experiment has ended.
+pub fn validate(
+    options: &Options,
+    jobs: usize,
+    progress: impl Fn(&str) + Sync,
+) -> Result<Vec<ExperimentResult>, ExperimentError> {
+    let work: Vec<(Options, &str, super::Experiment)> = [2, 3]
+        .into_iter()
+        .flat_map(|dimension| {
+            EXPERIMENTS
+                .iter()
+                .map(move |&(name, experiment)| (Options { dimension, ..options.clone() }, name, experiment))
+        })
+        .collect();
+    let next = std::sync::atomic::AtomicUsize::new(0);
+    let done: Vec<std::sync::Mutex<Option<Result<ExperimentResult, ExperimentError>>>> =
+        work.iter().map(|_| std::sync::Mutex::new(None)).collect();
+    std::thread::scope(|scope| {
+        for _ in 0..jobs.clamp(1, work.len()) {
+            scope.spawn(|| {
+                loop {
+                    let k = next.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
+                    let Some((options, name, experiment)) = work.get(k) else { break };
+                    progress(&options.slug(name));
+                    let result = experiment(options).and_then(|result| {
+                        result.write(&options.out)?;
+                        Ok(result)
+                    });
+                    *done[k].lock().unwrap_or_else(|e| e.into_inner()) = Some(result);
+                }
+            });
         }
+    });
+    let mut results = vec![numerics(options)];
+    for slot in done {
+        results.push(slot.into_inner().unwrap_or_else(|e| e.into_inner()).expect("every experiment ran")?);
     }
     write_report(&results, options)?;
     Ok(results)

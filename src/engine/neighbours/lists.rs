@@ -183,7 +183,7 @@ pub const RANGE_HOLDS_3D: f64 = 12.0;
 
 /// The skin for lists, or `None` for the grid that follows the particles: with no short
 /// periodic axis (`allow`), and for [`Neighbourhood::Auto`] from [`LISTS_FROM`]
-/// ([`LISTS_FROM_3D`] for spheres) on. The skin makes the range hold [`RANGE_HOLDS`]
+/// ([`LISTS_FROM_3D`] for spheres) on, unless the range would crowd (below). The skin makes the range hold [`RANGE_HOLDS`]
 /// ([`RANGE_HOLDS_3D`]) particles, within `[reach/4, reach]`, and short enough that a range
 /// plus a skin stays under half of every periodic box length (one image of a pair in range).
 pub(crate) fn skin_for<const D: usize>(
@@ -199,18 +199,24 @@ pub(crate) fn skin_for<const D: usize>(
         2 => (density * PI * 0.25 * reach * reach, LISTS_FROM),
         _ => (density * PI / 6.0 * reach * reach * reach, LISTS_FROM_3D),
     };
+    let range = match D {
+        2 => (RANGE_HOLDS / (PI * density)).sqrt(),
+        _ => (RANGE_HOLDS_3D / (4.0 / 3.0 * PI * density)).cbrt(),
+    };
+    // Where the range that holds RANGE_HOLDS particles is shorter than the smallest skin
+    // allows, a range would hold far more than a row: a size-asymmetric mixture (the reach
+    // is the large pair's, the density the small particles'), whose particles would all be
+    // crowded and search the grid after paying for the lists' upkeep. Never for equal
+    // particles: that takes η above 1.3 in 2D.
+    let crowds = range < 1.25 * reach;
     let wanted = match choice {
-        Neighbourhood::Auto => eta >= from,
+        Neighbourhood::Auto => eta >= from && !crowds,
         Neighbourhood::Grid => false,
         Neighbourhood::Lists => true,
     };
     if !(D == 2 || D == 3) || !allow || !wanted {
         return None;
     }
-    let range = match D {
-        2 => (RANGE_HOLDS / (PI * density)).sqrt(),
-        _ => (RANGE_HOLDS_3D / (4.0 / 3.0 * PI * density)).cbrt(),
-    };
     let mut skin = (range - reach).clamp(0.25 * reach, reach);
     for a in 0..D {
         if sim_box.boundary[a] == Boundary::Periodic {

@@ -31,6 +31,10 @@
 //!
 //! With lists, the cell grid ([`Cells`]) holds each particle by its centre, so a particle
 //! changes cell only when it rebuilds, with no crossing events.
+//!
+//! While the radii grow (a compression), `reach` is the largest contact distance at the end
+//! of the present stretch ([`GROWTH_STRETCH`]); the simulation builds everything again
+//! there.
 
 pub(crate) mod cells;
 pub(crate) mod lists;
@@ -43,6 +47,14 @@ pub use lists::{LISTS_FROM, LISTS_FROM_3D, RANGE_HOLDS, RANGE_HOLDS_3D};
 use lists::{List, NONE, Rows, skin_for};
 use nalgebra::SVector;
 use serde::{Deserialize, Serialize};
+
+/// During a compression the neighbourhood is built for radii this many times the present
+/// ones and rebuilt when they get there: cells and lists stay sized for the radii of the
+/// moment (never for the final ones from the start), and a periodic axis counts as short
+/// only once the present radii make it so. A rebuild costs about one prediction per
+/// particle; 5 % growth between them makes them rare even near jamming, where the radii
+/// barely grow, and keeps the cells at most 5 % wider than they need be.
+pub const GROWTH_STRETCH: f64 = 1.05;
 
 /// How [`Simulation`](super::Simulation) finds the particles that can touch one another.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
@@ -210,6 +222,14 @@ impl<const D: usize> Neighbours<D> {
         saved: Saved<D>,
         store: &impl Store,
     ) -> Result<Self, String> {
+        // Under `Auto`, the kind saved is the kind kept: a run resumes with the neighbourhood
+        // it had (whether a particle is crowded decides which stale predictions it makes),
+        // even where a later version of `Auto`'s rule would choose the other.
+        let choice = match (choice, &saved) {
+            (Neighbourhood::Auto, Saved::Centres(..)) => Neighbourhood::Lists,
+            (Neighbourhood::Auto, Saved::Cells(..)) => Neighbourhood::Grid,
+            (choice, _) => choice,
+        };
         let skin = skin_for(sim_box, reach, n, allow_lists, choice);
         let empty = |cells| Self::bare(sim_box, cells);
         match (skin, saved) {
@@ -606,5 +626,30 @@ mod tests {
             }
         }
         assert!(checked > 2500, "{checked}");
+    }
+
+    /// `Auto` keeps lists for dense equal disks and spheres and for a dense 1 : 1.4 mixture,
+    /// and not for a 1 : 10 mixture, whose range would hold dozens of small particles per
+    /// large one (every list crowded); `Lists` keeps them there all the same.
+    #[test]
+    fn auto_keeps_no_lists_where_they_would_all_be_crowded() {
+        use std::f64::consts::PI;
+        let square = |area: f64| SimBox { lengths: SVector::from([area.sqrt(); 2]), boundary: [Boundary::Periodic; 2] };
+        // 1000 equal disks of diameter 1 at η = 0.8; 500 + 500 of diameters 1 and 1.4 at 0.84.
+        let equal = square(1000.0 * PI / 4.0 / 0.8);
+        assert!(skin_for(&equal, 1.0, 1000, true, Neighbourhood::Auto).is_some());
+        let mixed = square(500.0 * PI / 4.0 * (1.0 + 1.96) / 0.84);
+        assert!(skin_for(&mixed, 1.4, 1000, true, Neighbourhood::Auto).is_some());
+        // 20 of diameter 1 among 400 of 0.1 at η = 0.85: the reach is 1, the density that of
+        // the small disks.
+        let asymmetric = square((20.0 + 400.0 * 0.01) * PI / 4.0 / 0.85);
+        assert_eq!(skin_for(&asymmetric, 1.0, 420, true, Neighbourhood::Auto), None);
+        assert!(skin_for(&asymmetric, 1.0, 420, true, Neighbourhood::Lists).is_some());
+        // Spheres: 1000 equal at η = 0.6.
+        let cube = SimBox {
+            lengths: SVector::from([(1000.0 * PI / 6.0 / 0.6f64).cbrt(); 3]),
+            boundary: [Boundary::Periodic; 3],
+        };
+        assert!(skin_for(&cube, 1.0, 1000, true, Neighbourhood::Auto).is_some());
     }
 }

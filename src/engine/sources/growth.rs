@@ -139,8 +139,22 @@ impl Growth {
 
     /// The largest radius the particles reach (at `until`).
     pub fn final_radius<const D: usize>(&self, particles: &[Particle<D>]) -> f64 {
+        self.largest_radius(particles, self.until)
+    }
+
+    /// The largest radius at time `t` (by the motion law: the same bits as every
+    /// prediction, and never smaller at a later time, each operation being monotone).
+    pub fn largest_radius<const D: usize>(&self, particles: &[Particle<D>], t: f64) -> f64 {
         let radii = self.radii();
-        particles.iter().map(|p| radii.radius(p.radius, self.until)).fold(0.0, f64::max)
+        particles.iter().map(|p| radii.radius(p.radius, t)).fold(0.0, f64::max)
+    }
+
+    /// When every radius will be `factor` (> 1) times what it is at `now`: the time `t`
+    /// with `1 + rate·(t − origin) = factor·(1 + rate·(now − origin))`, or `until` if that
+    /// comes first (or if rounding leaves `t` no later than `now`).
+    pub fn grown_by(&self, now: f64, factor: f64) -> f64 {
+        let t = self.origin + (factor * (1.0 + self.rate * (now - self.origin)) - 1.0) / self.rate;
+        if t > now && t < self.until { t } else { self.until }
     }
 
     /// The end of the growth (the global event's time).
