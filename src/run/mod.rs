@@ -116,6 +116,15 @@ pub enum Phase {
 }
 
 impl Phase {
+    /// The configuration's name of the phase (as in summary.json's progress messages).
+    pub fn name(&self) -> &'static str {
+        match self {
+            Phase::Compression => "compression",
+            Phase::Equilibration => "equilibration",
+            Phase::Production => "production",
+        }
+    }
+
     fn is_production(&self) -> bool {
         *self == Phase::Production
     }
@@ -423,6 +432,24 @@ impl<const D: usize> Run<D> {
         if self.phase.is_production() {
             self.sim.sample_every(sample_interval);
         }
+        Ok(())
+    }
+
+    /// Makes the production end `collisions` pair collisions and/or `time` time units from
+    /// now (from its start while it has not started), whichever comes first, without
+    /// touching anything else (the sampling goes on as it was): how the Python package runs
+    /// "this much more". Validated as the configuration's `[run]` would be; at least one
+    /// length must be given.
+    pub fn extend_production(&mut self, collisions: Option<u64>, time: Option<f64>) -> Result<(), Invalid> {
+        let (done, elapsed) = match self.phase.is_production() {
+            true => (self.collisions(), self.sim.time() - self.thermo.start_time),
+            false => (0, 0.0),
+        };
+        let mut config = self.config.clone();
+        config.run.collisions = collisions.map(|c| done.saturating_add(c));
+        config.run.time = time.map(|t| elapsed + t);
+        config.check_for(D)?;
+        self.config = config;
         Ok(())
     }
 
