@@ -278,26 +278,7 @@ fn in_parallel<F>(jobs: usize, job: F) -> Result<Vec<Packing>, ExperimentError>
 where
     F: Fn(usize) -> Result<Packing, ExperimentError> + Sync,
 {
-    use std::sync::Mutex;
-    use std::sync::atomic::{AtomicUsize, Ordering};
-    let next = AtomicUsize::new(0);
-    let results: Mutex<Vec<Option<Result<Packing, ExperimentError>>>> = Mutex::new((0..jobs).map(|_| None).collect());
-    let workers = std::thread::available_parallelism().map_or(1, |n| n.get()).min(jobs).max(1);
-    std::thread::scope(|scope| {
-        for _ in 0..workers {
-            scope.spawn(|| {
-                loop {
-                    let k = next.fetch_add(1, Ordering::Relaxed);
-                    if k >= jobs {
-                        break;
-                    }
-                    let result = job(k);
-                    results.lock().expect("no worker panics")[k] = Some(result);
-                }
-            });
-        }
-    });
-    results.into_inner().expect("no worker panics").into_iter().map(|r| r.expect("every job ran")).collect()
+    super::in_parallel(jobs, std::thread::available_parallelism().map_or(1, |n| n.get()), job)
 }
 
 /// The packings of one dimension: every rate and seed (fastest rate first), then the slow

@@ -244,6 +244,35 @@ fn two() -> usize {
 /// An experiment's entry point.
 pub type Experiment = fn(&Options) -> Result<ExperimentResult, ExperimentError>;
 
+/// Runs `job(0)`, …, `job(jobs − 1)` on `workers` threads (at least one), each taking the
+/// next job as it finishes one; the results in the jobs' order, or the first error in that
+/// order once every job has ended. The jobs are independent, so the results do not depend
+/// on `workers`.
+pub fn in_parallel<T: Send, F>(jobs: usize, workers: usize, job: F) -> Result<Vec<T>, ExperimentError>
+where
+    F: Fn(usize) -> Result<T, ExperimentError> + Sync,
+{
+    use std::sync::Mutex;
+    use std::sync::atomic::{AtomicUsize, Ordering};
+    let next = AtomicUsize::new(0);
+    let results: Mutex<Vec<Option<Result<T, ExperimentError>>>> = Mutex::new((0..jobs).map(|_| None).collect());
+    std::thread::scope(|scope| {
+        for _ in 0..workers.clamp(1, jobs.max(1)) {
+            scope.spawn(|| {
+                loop {
+                    let k = next.fetch_add(1, Ordering::Relaxed);
+                    if k >= jobs {
+                        break;
+                    }
+                    let result = job(k);
+                    results.lock().expect("no worker panics")[k] = Some(result);
+                }
+            });
+        }
+    });
+    results.into_inner().expect("no worker panics").into_iter().map(|r| r.expect("every job ran")).collect()
+}
+
 /// The options of an experiment on the command line (`--quick`, `--seed`, `--out`): the
 /// experiment binaries and `collide experiment` take the same.
 #[derive(clap::Args, Clone, Debug)]

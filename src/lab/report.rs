@@ -157,29 +157,15 @@ pub fn validate(
                 .map(move |&(name, experiment)| (Options { dimension, ..options.clone() }, name, experiment))
         })
         .collect();
-    let next = std::sync::atomic::AtomicUsize::new(0);
-    let done: Vec<std::sync::Mutex<Option<Result<ExperimentResult, ExperimentError>>>> =
-        work.iter().map(|_| std::sync::Mutex::new(None)).collect();
-    std::thread::scope(|scope| {
-        for _ in 0..jobs.clamp(1, work.len()) {
-            scope.spawn(|| {
-                loop {
-                    let k = next.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
-                    let Some((options, name, experiment)) = work.get(k) else { break };
-                    progress(&options.slug(name));
-                    let result = experiment(options).and_then(|result| {
-                        result.write(&options.out)?;
-                        Ok(result)
-                    });
-                    *done[k].lock().unwrap_or_else(|e| e.into_inner()) = Some(result);
-                }
-            });
-        }
-    });
+    let done = super::in_parallel(work.len(), jobs, |k| {
+        let (options, name, experiment) = &work[k];
+        progress(&options.slug(name));
+        let result = experiment(options)?;
+        result.write(&options.out)?;
+        Ok(result)
+    })?;
     let mut results = vec![numerics(options)];
-    for slot in done {
-        results.push(slot.into_inner().unwrap_or_else(|e| e.into_inner()).expect("every experiment ran")?);
-    }
+    results.extend(done);
     write_report(&results, options)?;
     Ok(results)
 }
