@@ -22,6 +22,9 @@
 //!   [`Sink`](run::Sink) (the files of `collide run`; every observer is one); it reports a
 //!   [`Summary`](run::Summary) and saves [`Checkpoint`](run::Checkpoint)s that continue it
 //!   bit-identically.
+//! * A [`sweep`] is many runs of one configuration with values varied, each task a run
+//!   directory of its own, run in parallel processes or as a scheduler's job array, and
+//!   collected into one table.
 //! * The [`lab`] turns runs into checks against the formulas of [`theory`]; [`bench`](mod@bench) times
 //!   the engine beside the hardware's floor; [`query`] answers the numerical questions of
 //!   `collide roots` and `collide contact-time` line by line.
@@ -89,6 +92,7 @@ pub mod lab;
 pub mod observe;
 pub mod query;
 pub mod run;
+pub mod sweep;
 pub mod text;
 pub mod theory;
 

@@ -38,6 +38,11 @@ enum Command {
     /// Runs a simulation: `collide run [CONFIG.toml] [--out DIR]`, or `--resume CHECKPOINT`.
     /// Without a file, runs the embedded default (`collide run --print-default` shows it).
     Run(RunArgs),
+    /// Runs a sweep: one run configuration with values varied (`[base]`, `[vary]`,
+    /// `[[zip]]`), each task a run in DIR/tasks/NNNN/, on this machine's cores (`--jobs`) or
+    /// as a Slurm job array (`--emit slurm`), collected into DIR/results.csv. Rerunning skips
+    /// finished tasks and continues interrupted ones.
+    Sweep(SweepArgs),
     /// Runs every physics experiment and writes a validation report (`index.html`,
     /// `report.md`); the default when no command is given. Exits non-zero if a check fails.
     Validate(ValidateArgs),
@@ -168,6 +173,50 @@ struct RunArgs {
 }
 
 #[derive(Args)]
+struct SweepArgs {
+    /// The sweep file (TOML: [base], [vary], [[zip]], optional [plot] and [slurm]).
+    sweep: PathBuf,
+    /// Output directory: manifest.json, tasks/NNNN/ (one run each), results.csv,
+    /// results.json, results.svg.
+    #[arg(long, default_value = "sweep-out")]
+    out: PathBuf,
+    /// Tasks run at once, each a process of its own (default: the number of cores).
+    #[arg(long, value_parser = clap::value_parser!(u32).range(1..=4096))]
+    jobs: Option<u32>,
+    /// Run the failed tasks again (a rerun otherwise skips them, as it skips finished ones).
+    #[arg(long)]
+    retry_failed: bool,
+    /// Run task K alone (what each array task of a scheduler runs), then exit.
+    #[arg(long, value_name = "K", conflicts_with_all = ["emit", "collect", "jobs"])]
+    task: Option<usize>,
+    /// Write DIR/sweep.sbatch, a job array of the unfinished tasks, instead of running them.
+    #[arg(long, value_parser = ["slurm"], conflicts_with = "collect")]
+    emit: Option<String>,
+    /// Only build the tables from the tasks that have finished, naming what is missing or
+    /// failed (exit 1 unless every task finished).
+    #[arg(long, conflicts_with = "jobs")]
+    collect: bool,
+    /// Slurm: time limit per task (sbatch --time), instead of [slurm] time.
+    #[arg(long, requires = "emit")]
+    time: Option<String>,
+    /// Slurm: memory per task (sbatch --mem), instead of [slurm] mem.
+    #[arg(long, requires = "emit")]
+    mem: Option<String>,
+    /// Slurm: partition (sbatch --partition), instead of [slurm] partition.
+    #[arg(long, requires = "emit")]
+    partition: Option<String>,
+    /// Slurm: account (sbatch --account), instead of [slurm] account.
+    #[arg(long, requires = "emit")]
+    account: Option<String>,
+    /// Slurm: the most array tasks running at once (--array=…%K), instead of [slurm] throttle.
+    #[arg(long, requires = "emit", value_parser = clap::value_parser!(u32).range(1..))]
+    throttle: Option<u32>,
+    /// No progress line (it is drawn only on a terminal, and never when CI is set).
+    #[arg(long)]
+    quiet: bool,
+}
+
+#[derive(Args)]
 struct Output {
     /// Read JSON lines on stdin, answer one line each on stdout.
     #[arg(long)]
@@ -254,6 +303,7 @@ fn run(cli: Cli) -> Result<ExitCode> {
             Ok(ExitCode::SUCCESS)
         }
         Command::Run(args) => run_simulation(args),
+        Command::Sweep(args) => sweep(args),
         Command::Roots(args) => roots(args),
         Command::ContactTime(args) => contact(args),
         Command::Experiment(args) => {
@@ -287,6 +337,16 @@ fn help(command: Option<&str>) -> Result<ExitCode> {
 /// (`CI` set to anything but empty, `0` or `false`).
 fn progress_wanted(quiet: bool) -> bool {
     draw_progress(quiet, std::env::var("CI").ok().as_deref(), io::stderr().is_terminal())
+}
+
+/// A progress bar of `len` steps drawn with `template` when `wanted`, else a hidden one.
+fn progress_bar(wanted: bool, len: u64, template: &str) -> indicatif::ProgressBar {
+    if !wanted {
+        return indicatif::ProgressBar::hidden();
+    }
+    let bar = indicatif::ProgressBar::new(len);
+    bar.set_style(indicatif::ProgressStyle::with_template(template).expect("a valid template").progress_chars("=> "));
+    bar
 }
 
 /// [`progress_wanted`] given `--quiet`, the value of `CI` and whether stderr is a terminal.
@@ -414,17 +474,11 @@ fn run_simulation(args: RunArgs) -> Result<ExitCode> {
         say!("{}", DEFAULT_CONFIG.trim_end());
         return Ok(ExitCode::SUCCESS);
     }
-    let bar = if progress_wanted(args.quiet) {
-        let bar = indicatif::ProgressBar::new(1000);
-        bar.set_style(
-            indicatif::ProgressStyle::with_template("{prefix} [{bar:40}] {percent:>3}% {elapsed_precise} (eta {eta})")
-                .expect("a valid template")
-                .progress_chars("=> "),
-        );
-        bar
-    } else {
-        indicatif::ProgressBar::hidden()
-    };
+    let bar = progress_bar(
+        progress_wanted(args.quiet),
+        1000,
+        "{prefix} [{bar:40}] {percent:>3}% {elapsed_precise} (eta {eta})",
+    );
     let mut shown = None;
     let progress = |phase: Phase, done: f64| {
         if shown != Some(phase) {
@@ -542,6 +596,179 @@ fn run_simulation(args: RunArgs) -> Result<ExitCode> {
     );
     say!("results in {out}");
     Ok(ExitCode::SUCCESS)
+}
+
+fn sweep(args: SweepArgs) -> Result<ExitCode> {
+    use collide::sweep::local::{self, Ended, Progress};
+    use collide::sweep::task::{self, Outcome, State};
+    use collide::sweep::{Sweep, slurm, table};
+    use std::sync::Arc;
+    use std::sync::atomic::AtomicBool;
+    let sweep = Sweep::load(&args.sweep)?;
+    let tasks = sweep.tasks()?;
+    let n = tasks.len();
+    let out = &args.out;
+    let stop = Arc::new(AtomicBool::new(false));
+    for signal in [signal_hook::consts::SIGINT, signal_hook::consts::SIGTERM] {
+        signal_hook::flag::register(signal, Arc::clone(&stop)).context("installing the signal handlers")?;
+    }
+    if let Some(k) = args.task {
+        let Some(t) = tasks.get(k) else {
+            bail!("--task {k}: {} makes {n} tasks, numbered 0 to {}", sweep.source, n - 1);
+        };
+        task::check_manifest(out, t, n)?;
+        let dir = task::dir(out, t, n);
+        let name =
+            if t.parameters.is_empty() { format!("task {k} (the base)") } else { format!("task {k} ({})", t.label()) };
+        return Ok(match task::run(t, &dir, args.retry_failed, &stop)? {
+            Outcome::AlreadyFinished => {
+                say!("{name}: finished before; results in {}", dir.display());
+                ExitCode::SUCCESS
+            }
+            Outcome::AlreadyFailed(error) => {
+                eprintln!("collide: {name}: failed before ({error}); --retry-failed runs it again");
+                ExitCode::FAILURE
+            }
+            Outcome::Finished(s) => {
+                say!(
+                    "{name}: {} collisions in {:.2} s; Z = {:.5} ± {:.5}; results in {}",
+                    s.collisions,
+                    s.wall_time_s,
+                    s.compressibility,
+                    s.compressibility_error,
+                    dir.display()
+                );
+                ExitCode::SUCCESS
+            }
+            Outcome::Failed(error) => {
+                eprintln!("collide: {name}: {error}");
+                ExitCode::FAILURE
+            }
+            Outcome::Interrupted => {
+                eprintln!(
+                    "collide: {name}: interrupted; its checkpoint is in {}; running the task again continues it",
+                    dir.display()
+                );
+                ExitCode::from(130)
+            }
+        });
+    }
+    task::write_manifest(out, &sweep.source, &sweep.keys(), &tasks)?;
+    let states: Vec<State> = tasks.iter().map(|t| task::state(&task::dir(out, t, n), t)).collect();
+    let todo: Vec<usize> = states
+        .iter()
+        .enumerate()
+        .filter(|(_, s)| match s {
+            State::Finished => false,
+            State::Failed(_) => args.retry_failed,
+            _ => true,
+        })
+        .map(|(k, _)| k)
+        .collect();
+    let done_before = states.iter().filter(|s| **s == State::Finished).count();
+    if args.emit.is_some() {
+        if todo.is_empty() {
+            say!("all {n} tasks of {} have finished (or failed: --retry-failed); nothing to submit", sweep.source);
+            return Ok(ExitCode::SUCCESS);
+        }
+        let absolute = |p: &std::path::Path| std::path::absolute(p).with_context(|| p.display().to_string());
+        let mut options = sweep.slurm.clone();
+        for (value, slot) in [
+            (&args.time, &mut options.time),
+            (&args.mem, &mut options.mem),
+            (&args.partition, &mut options.partition),
+            (&args.account, &mut options.account),
+        ] {
+            if value.is_some() {
+                slot.clone_from(value);
+            }
+        }
+        options.throttle = args.throttle.or(options.throttle);
+        let exe = std::env::current_exe().context("locating the collide binary")?;
+        let script = slurm::emit(&exe, &absolute(&args.sweep)?, &absolute(out)?, &todo, &options, args.retry_failed)?;
+        say!(
+            "{} tasks of {n} in the array ({}); submit with: sbatch {}",
+            script.tasks,
+            script.array,
+            script.path.display()
+        );
+        if todo.last().is_some_and(|&k| k >= 1001) {
+            eprintln!(
+                "collide: note: Slurm's default MaxArraySize is 1001 (indices up to 1000); a larger array needs it raised, or the sweep split"
+            );
+        }
+        return Ok(ExitCode::SUCCESS);
+    }
+    if !args.collect && !todo.is_empty() {
+        let cores = std::thread::available_parallelism().map_or(1, |c| c.get());
+        let jobs = args.jobs.map_or(cores, |j| j as usize);
+        eprintln!(
+            "{n} tasks: {done_before} finished before, {} to run, {} at a time",
+            todo.len(),
+            jobs.min(todo.len())
+        );
+        let exe = std::env::current_exe().context("locating the collide binary")?;
+        let terminal = progress_wanted(args.quiet);
+        let bar = progress_bar(terminal, todo.len() as u64, "sweep [{bar:30}] {pos}/{len} {msg} {elapsed_precise}");
+        let (mut running, mut failed) = (0usize, 0usize);
+        let width = tasks[0].dir_name(n).len();
+        let report = |p: Progress| {
+            match &p {
+                Progress::Started { .. } => running += 1,
+                Progress::Ended { index, ended, seconds } => {
+                    running -= 1;
+                    bar.inc(1);
+                    let how = match ended {
+                        Ended::Finished => "finished".to_string(),
+                        Ended::Failed(e) => {
+                            failed += 1;
+                            format!("failed: {e}")
+                        }
+                        Ended::Interrupted => "interrupted (its checkpoint continues it)".to_string(),
+                    };
+                    let line = format!("task {index:0width$} {how} ({seconds:.1} s)");
+                    if terminal { bar.println(line) } else { eprintln!("{line}") }
+                }
+            }
+            bar.set_message(format!("· {running} running · {failed} failed"));
+        };
+        local::run(&exe, &args.sweep, out, &tasks, &todo, jobs, args.retry_failed, &stop, report)?;
+        bar.finish_and_clear();
+    }
+    let collected = table::collect(&sweep, &tasks, out)?;
+    let count = |name: &str| collected.with(name).len();
+    say!(
+        "{n} tasks: {} finished, {} failed, {} interrupted, {} missing",
+        count("finished"),
+        count("failed"),
+        count("interrupted"),
+        count("missing")
+    );
+    for row in collected.with("failed") {
+        if let State::Failed(e) = &row.state {
+            eprintln!("collide: task {} failed: {e} ({})", row.index, out.join(&row.dir).display());
+        }
+    }
+    let list = |name: &str| collected.with(name).iter().map(|r| r.index.to_string()).collect::<Vec<_>>().join(", ");
+    if count("missing") > 0 {
+        eprintln!("collide: not finished (not run, running, or killed): tasks {}", list("missing"));
+    }
+    if count("interrupted") > 0 {
+        eprintln!("collide: interrupted, continued by the next run: tasks {}", list("interrupted"));
+    }
+    if let Some(why) = &collected.no_plot {
+        eprintln!("collide: no results.svg: {why}");
+    }
+    for file in &collected.files {
+        say!("wrote {}", file.display());
+    }
+    Ok(if collected.complete() {
+        ExitCode::SUCCESS
+    } else if stop.load(std::sync::atomic::Ordering::Relaxed) || count("interrupted") > 0 && count("failed") == 0 {
+        ExitCode::from(130)
+    } else {
+        ExitCode::FAILURE
+    })
 }
 
 fn validate(args: ValidateArgs) -> Result<ExitCode> {

@@ -155,10 +155,19 @@ fn digest<const D: usize>(version: &str, run: &Saved<D>) -> String {
     hash.0.update(version.as_bytes());
     hash.0.update([0u8]);
     serde_json::to_writer(&mut hash, run).expect("a saved state serialises");
-    let bytes = hash.0.finalize();
+    labelled(&hash.0.finalize())
+}
+
+/// `"sha256:"` and the SHA-256 of `bytes` in hex: how collide writes a digest (a sweep task's
+/// configuration has one too).
+pub fn sha256(bytes: &[u8]) -> String {
+    labelled(&Sha256::digest(bytes))
+}
+
+fn labelled(digest: &[u8]) -> String {
     let mut hex = String::with_capacity(7 + 64);
     hex.push_str("sha256:");
-    for b in bytes.iter() {
+    for b in digest {
         hex.push_str(&format!("{b:02x}"));
     }
     hex

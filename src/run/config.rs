@@ -485,6 +485,23 @@ impl Config {
         Ok(config)
     }
 
+    /// Validates a configuration already parsed into a TOML table (a sweep's task: its
+    /// `[base]` with the varied values set); `source` names it in errors. Type errors and
+    /// unknown keys are reported without a position (the table has no text).
+    pub fn from_table(table: toml::Table, source: &str) -> Result<Config, ConfigError> {
+        let config: Config = toml::Value::Table(table).try_into().map_err(|e: toml::de::Error| {
+            ConfigError::Syntax { source: source.to_string(), at: None, message: e.message().to_string() }
+        })?;
+        config.check().map_err(|invalid| ConfigError::Invalid { source: source.to_string(), invalid })?;
+        Ok(config)
+    }
+
+    /// The configuration as TOML text that [`Config::parse`] reads back to the same value
+    /// (every field written, defaults included; floats in their shortest round-trip form).
+    pub fn to_toml(&self) -> String {
+        toml::to_string(self).expect("a configuration serialises to TOML")
+    }
+
     /// Reads, parses and validates a file.
     pub fn load(path: &Path) -> Result<Config, ConfigError> {
         let source = path.display().to_string();
