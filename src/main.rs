@@ -155,7 +155,7 @@ struct RunArgs {
     #[arg(long, default_value = "collide-out")]
     out: PathBuf,
     /// Replace the files of an earlier run in the output directory (only those:
-    /// summary.json, timeseries.csv, trajectory.xyz, checkpoint.json).
+    /// summary.json, timeseries.csv, trajectory.xyz, checkpoint.json, rdf.csv).
     #[arg(long)]
     force: bool,
     /// No progress bar (it is drawn only on a terminal, and never when CI is set).

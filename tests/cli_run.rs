@@ -2,20 +2,9 @@
 
 mod common;
 
-use common::BASE;
+use common::{BASE, collide, scratch};
 use std::path::{Path, PathBuf};
-use std::process::{Command, Output};
-
-fn collide(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_collide")).args(args).output().expect("the binary runs")
-}
-
-fn scratch(name: &str) -> PathBuf {
-    let dir = Path::new(env!("CARGO_TARGET_TMPDIR")).join(name);
-    let _ = std::fs::remove_dir_all(&dir);
-    std::fs::create_dir_all(&dir).unwrap();
-    dir
-}
+use std::process::Command;
 
 fn json(path: &Path) -> serde_json::Value {
     serde_json::from_str(&std::fs::read_to_string(path).unwrap()).unwrap()

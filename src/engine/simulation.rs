@@ -642,6 +642,18 @@ impl<const D: usize> Simulation<D> {
         Reading { particles: &self.particles, queue: &self.queue, neighbours: &self.neighbours }
     }
 
+    /// A time before which no particle changes course: the earliest pending event's (a
+    /// stale marker's included, which only makes it earlier), the growth's end, the
+    /// neighbourhood's next rebuild while growing. Every particle is in free flight from its
+    /// last update to this time, so its position and velocity there are known: an observer
+    /// that samples at instants of its own samples at those up to this time before the next
+    /// [`step`](Self::step).
+    pub fn quiet_until(&mut self) -> f64 {
+        let (_, next) = self.queue.first();
+        let end = self.growth.map_or(f64::INFINITY, |g| g.predict());
+        next.time.min(end).min(self.holds_until.unwrap_or(f64::INFINITY))
+    }
+
     /// Processes the next event and reports it; `None` when nothing can happen any more.
     pub fn step(&mut self) -> Option<Outcome<D>> {
         loop {

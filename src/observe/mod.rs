@@ -9,7 +9,12 @@
 //! * [`Thermo`]: temperature, the collision-virial and wall pressures, the samples of the time
 //!   series (every run has it; its estimators are specified in [`thermo`]).
 //! * The registered observables a configuration names under `[observe.<name>]`
-//!   ([`Selection`]): [`velocities`] (the velocity distribution against the Maxwellian).
+//!   ([`Selection`]): [`velocities`] (the velocity distribution against the Maxwellian),
+//!   [`rdf`] (g(r) per species pair and its contact value). An observable that samples at
+//!   instants of its own (every `every` time units) says when it is next
+//!   [due](Observable::due); the run hands it the particles at that instant, before the
+//!   event that follows it ([`Observable::sample`]), and writes its own files at the end
+//!   ([`Observable::files`]).
 //! * [`contacts`]: the contact network of a dense state (contacts per particle, rattlers),
 //!   an analysis of one state rather than an observer of events; likewise [`order`], its
 //!   bond-orientational order (Ψ₆ of disks, Q₆ of spheres: crystal or amorphous).
@@ -26,6 +31,7 @@
 pub mod blocks;
 pub mod contacts;
 pub mod order;
+pub mod rdf;
 pub mod thermo;
 pub mod velocities;
 
@@ -50,6 +56,9 @@ pub struct Selection {
     /// The velocity distribution at the start and at every sample ([`velocities`]).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub velocities: Option<velocities::Options>,
+    /// The radial distribution function ([`rdf`]).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub rdf: Option<rdf::Options>,
 }
 
 impl Selection {
@@ -58,11 +67,22 @@ impl Selection {
         *self == Selection::default()
     }
 
+    /// Checks the options: the key, its value and what is allowed.
+    pub fn check(&self) -> Result<(), (String, String, String)> {
+        if let Some(options) = &self.rdf {
+            options.check()?;
+        }
+        Ok(())
+    }
+
     /// The observables asked for, observing `sim` from now, in registry order.
     pub fn start<const D: usize>(&self, sim: &Simulation<D>) -> Vec<Observable> {
         let mut out = Vec::new();
         if let Some(options) = &self.velocities {
             out.push(Observable::Velocities(velocities::Velocities::new(sim, options.clone())));
+        }
+        if let Some(options) = &self.rdf {
+            out.push(Observable::Rdf(rdf::Rdf::new(sim, options.clone())));
         }
         out
     }
@@ -72,6 +92,9 @@ impl Selection {
         let mut out = Vec::new();
         if self.velocities.is_some() {
             out.push("velocities");
+        }
+        if self.rdf.is_some() {
+            out.push("rdf");
         }
         out
     }
@@ -84,6 +107,8 @@ impl Selection {
 pub enum Observable {
     /// The velocity distribution.
     Velocities(velocities::Velocities),
+    /// g(r).
+    Rdf(rdf::Rdf),
 }
 
 impl Observable {
@@ -91,6 +116,7 @@ impl Observable {
     pub fn name(&self) -> &'static str {
         match self {
             Observable::Velocities(_) => "velocities",
+            Observable::Rdf(_) => "rdf",
         }
     }
 
@@ -98,6 +124,7 @@ impl Observable {
     pub fn results(&self) -> serde_json::Value {
         match self {
             Observable::Velocities(v) => serde_json::to_value(v),
+            Observable::Rdf(g) => serde_json::to_value(g.results()),
         }
         .expect("results serialise")
     }
@@ -106,6 +133,33 @@ impl Observable {
     pub fn dimension(&self) -> usize {
         match self {
             Observable::Velocities(v) => v.dimension,
+            Observable::Rdf(g) => g.dimension,
+        }
+    }
+
+    /// When it next samples at an instant of its own (`None`: it samples on events only).
+    #[inline]
+    pub fn due(&self) -> Option<f64> {
+        match self {
+            Observable::Velocities(_) => None,
+            Observable::Rdf(g) => Some(g.due()),
+        }
+    }
+
+    /// Samples at the instant `t` it was [`due`](Self::due): `sim`'s particles are all in
+    /// free flight from their last update to `t` (no event lies between).
+    pub fn sample<const D: usize>(&mut self, sim: &Simulation<D>, t: f64) {
+        match self {
+            Observable::Velocities(_) => {}
+            Observable::Rdf(g) => g.sample(sim.particles(), sim.sim_box(), t),
+        }
+    }
+
+    /// The files it writes into a run's directory: name and contents.
+    pub fn files(&self) -> Vec<(&'static str, String)> {
+        match self {
+            Observable::Velocities(_) => Vec::new(),
+            Observable::Rdf(g) => vec![("rdf.csv", g.csv())],
         }
     }
 }
@@ -115,6 +169,7 @@ impl<const D: usize> Observer<D> for Observable {
     fn observe(&mut self, sim: &Simulation<D>, outcome: &Outcome<D>) {
         match self {
             Observable::Velocities(v) => v.observe(sim, outcome),
+            Observable::Rdf(g) => g.observe(sim, outcome),
         }
     }
 }

@@ -657,6 +657,7 @@ impl Config {
                 format!("this is a {d}D run: give dimension = {d}"),
             ));
         }
+        self.observe.check().map_err(|(field, value, allowed)| Invalid::value(field, value, allowed))?;
         let positive = |name: &str, x: f64| {
             if x.is_finite() && x > 0.0 {
                 Ok(())

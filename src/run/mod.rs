@@ -130,6 +130,11 @@ impl Phase {
     }
 }
 
+/// The earliest instant any of `observables` samples at.
+fn next_due(observables: &[Observable]) -> Option<f64> {
+    observables.iter().filter_map(Observable::due).reduce(f64::min)
+}
+
 /// How a run ended.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
 #[serde(rename_all = "kebab-case")]
@@ -201,6 +206,9 @@ pub struct Run<const D: usize> {
     pub thermo: Thermo,
     /// The observables the configuration names (started when production starts).
     pub observables: Vec<Observable>,
+    /// The earliest instant an observable samples at (`None`: none samples at instants of its
+    /// own), kept so that a run without one pays nothing per event.
+    next_due: Option<f64>,
     /// What the equilibration did.
     pub equilibration: Equilibration,
     /// The compression, with `[compress]`.
@@ -362,6 +370,7 @@ impl<const D: usize> Run<D> {
             thermo: Thermo::new(&sim),
             sim,
             observables: Vec::new(),
+            next_due: None,
             equilibration: Equilibration::default(),
             compression,
             limits,
@@ -553,6 +562,7 @@ impl<const D: usize> Run<D> {
             config,
             sim,
             thermo,
+            next_due: next_due(&observables),
             observables,
             equilibration,
             compression,
@@ -622,9 +632,26 @@ impl<const D: usize> Run<D> {
         self.equilibration = Equilibration { collisions: self.sim.counts().pair - c0, time: self.sim.time() - t0 };
         self.thermo = Thermo::new(&self.sim);
         self.observables = self.config.observe.start(&self.sim);
+        self.next_due = next_due(&self.observables);
         self.start_counts = self.sim.counts();
         self.sim.sample_every(self.config.run.sample_interval);
         self.phase = Phase::Production;
+    }
+
+    /// Hands the observables that sample at instants of their own every instant up to
+    /// [`Simulation::quiet_until`] (the particles in free flight until then), earliest first.
+    fn sample_due(&mut self) {
+        let quiet = self.sim.quiet_until();
+        while let Some(t) = self.next_due
+            && t <= quiet
+        {
+            for observable in &mut self.observables {
+                if observable.due() == Some(t) {
+                    observable.sample(&self.sim, t);
+                }
+            }
+            self.next_due = next_due(&self.observables);
+        }
     }
 
     /// Production pair collisions so far.
@@ -724,6 +751,9 @@ impl<const D: usize> Run<D> {
             }
             if production && self.thermo.samples.len() >= limits.max_samples {
                 return Ok(Some(Status::TooManySamples));
+            }
+            if production && self.next_due.is_some() {
+                self.sample_due();
             }
             let Some(outcome) = self.sim.step() else { break };
             if compressing && let Some(c) = self.compression.as_mut() {

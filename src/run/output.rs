@@ -277,6 +277,11 @@ fn finish<const D: usize, P: FnMut(Phase, f64)>(
         dir.write_with("checkpoint.json", |w| checkpoint.write_json(w))?;
     }
     dir.write("timeseries.csv", timeseries_csv(run).as_bytes())?;
+    for observable in &run.observables {
+        for (name, contents) in observable.files() {
+            dir.write(name, contents.as_bytes())?;
+        }
+    }
     let mut summary = run.summary();
     summary.warnings.extend(warnings);
     let json = serde_json::to_string_pretty(&summary).expect("a summary serialises");

@@ -24,8 +24,8 @@ use std::fs::{self, File, OpenOptions};
 use std::io::{self, Read, Seek, Write};
 use std::path::{Path, PathBuf};
 
-/// The files of a run.
-pub const RUN_FILES: [&str; 4] = ["summary.json", "timeseries.csv", "trajectory.xyz", "checkpoint.json"];
+/// The files of a run (the observables' files among them: `rdf.csv`).
+pub const RUN_FILES: [&str; 5] = ["summary.json", "timeseries.csv", "trajectory.xyz", "checkpoint.json", "rdf.csv"];
 
 /// The lock file.
 pub const LOCK: &str = ".collide.lock";

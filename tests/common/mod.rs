@@ -4,6 +4,21 @@
 
 use collide::engine::{ReferenceSimulation, Simulation};
 use collide::run::Summary;
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
+
+/// Runs the collide binary with `args`.
+pub fn collide(args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_collide")).args(args).output().expect("the binary runs")
+}
+
+/// An empty directory of the test's own under the target's scratch space.
+pub fn scratch(name: &str) -> PathBuf {
+    let dir = Path::new(env!("CARGO_TARGET_TMPDIR")).join(name);
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).unwrap();
+    dir
+}
 
 /// A small mixture with walls along y, a trajectory and periodic checkpoints, that runs in
 /// a fraction of a second; the tests edit it.
