@@ -278,3 +278,20 @@ def test_samples_are_the_command_lines_time_series(tmp_path):
     assert np.array_equal(got["pressure_walls"][:, 0, 0], series["pressure_wall_x_lower"])
     assert np.array_equal(got["pressure_walls"][:, 0, 1], series["pressure_wall_x_upper"])
     assert np.all(np.isnan(got["pressure_walls"][:, 1]))
+
+
+def test_observables_run_in_the_package_as_in_the_command_line(tmp_path):
+    text = collide.default_config().replace("[run]", "[observe.rdf]\nr_max = 3.0\nbins = 300\n\n[run]")
+    sim = collide.Simulation.from_config(text)
+    assert sim.run() == "complete"
+    got = sim.summary()["observables"]["rdf"]
+    expected = cli_summary(text, tmp_path, "rdf")["observables"]["rdf"]
+    assert got == expected
+    (contact,) = got["contact"]
+    assert contact["species"] == [0, 0] and contact["sigma"] == 1.0
+    # The pressure route of the same run, within the 3σ-equivalent of both errors.
+    s = sim.summary()
+    eta = s["packing_fraction"]
+    g_pressure = (s["compressibility"] - 1) / (2 * eta)
+    error = (contact["error"] ** 2 + (s["compressibility_error"] / (2 * eta)) ** 2) ** 0.5
+    assert abs(contact["g"] - g_pressure) < 3.45 * error
