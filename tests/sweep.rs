@@ -218,6 +218,20 @@ fn single_tasks_collect_and_the_slurm_script() {
     }
     assert!(out.join("manifest.json").is_file() && !out.join("tasks/0000").exists(), "emitting runs nothing");
 
+    // A task another process is running (it holds the directory's lock) is refused, its
+    // directory untouched; once the lock is gone it runs.
+    {
+        let busy = out.join("tasks/0000");
+        let _held = collide::run::rundir::RunDir::open(&busy, false, Some(&busy)).unwrap();
+        std::fs::write(busy.join("summary.json"), "{}").unwrap();
+        let refused = collide(&["sweep", f, "--out", o, "--task", "0"]);
+        assert_eq!(refused.status.code(), Some(2), "{}", text(&refused));
+        assert!(text(&refused).contains("another collide run is writing"), "{}", text(&refused));
+        assert_eq!(std::fs::read_to_string(busy.join("summary.json")).unwrap(), "{}", "untouched");
+        assert!(!busy.join("failed.json").exists() && !busy.join("task.json").exists());
+        std::fs::remove_file(busy.join("summary.json")).unwrap();
+    }
+
     // Two tasks by number, as array elements would run them.
     for k in ["4", "1"] {
         let t = collide(&["sweep", f, "--out", o, "--task", k]);
@@ -226,7 +240,7 @@ fn single_tasks_collect_and_the_slurm_script() {
     }
     let again = collide(&["sweep", f, "--out", o, "--task", "4"]);
     assert!(again.status.success() && text(&again).contains("finished before"), "{}", text(&again));
-    assert!(!out.join("tasks/0000").exists() && !out.join("tasks/0002").exists());
+    assert!(!out.join("tasks/0000/summary.json").exists() && !out.join("tasks/0002").exists());
     let beyond = collide(&["sweep", f, "--out", o, "--task", "6"]);
     assert_eq!(beyond.status.code(), Some(2));
     assert!(text(&beyond).contains("makes 6 tasks, numbered 0 to 5"), "{}", text(&beyond));

@@ -16,7 +16,7 @@
 
 use super::{SweepError, Task};
 use crate::run::output::{AnyCheckpoint, RunFailure, RunOptions, Start, load_any_checkpoint, run_into};
-use crate::run::rundir::write_atomic;
+use crate::run::rundir::{OutputError, RunDir, write_atomic};
 use crate::run::{Status, Summary};
 use serde::{Deserialize, Serialize};
 use std::path::{Path, PathBuf};
@@ -156,7 +156,10 @@ pub fn run(task: &Task, dir: &Path, retry_failed: bool, stop: &AtomicBool) -> Re
         State::Failed(error) if !retry_failed => return Ok(Outcome::AlreadyFailed(error.clone())),
         _ => {}
     }
-    std::fs::create_dir_all(dir).map_err(crate::run::rundir::at(dir))?;
+    // Another process running this task (an array element submitted twice, a second sweep
+    // into the same directory) holds the directory's lock: refused before any of its files
+    // is touched. (Opening creates the directory; resuming there is always allowed.)
+    drop(RunDir::open(dir, false, Some(dir))?);
     let checkpoint = dir.join("checkpoint.json");
     let resumed = match state {
         State::Interrupted => load_any_checkpoint(&checkpoint).ok(),
@@ -219,8 +222,13 @@ pub fn run(task: &Task, dir: &Path, retry_failed: bool, stop: &AtomicBool) -> Re
 }
 
 /// Records a failure the task's own process could not record (it was killed, or crashed):
-/// `error` in `failed.json`, if the task's record is this task's.
+/// `error` in `failed.json`, if the task's record is this task's — and no other process is
+/// running the task (then the process that ended was refused its directory, and the task is
+/// not failed).
 pub fn record_failure(task: &Task, dir: &Path, error: &str) -> Result<(), SweepError> {
+    if matches!(RunDir::open(dir, false, Some(dir)), Err(OutputError::Locked { .. })) {
+        return Ok(());
+    }
     if state(dir, task) == State::NotFinished
         && std::fs::read(dir.join(RECORD))
             .ok()
