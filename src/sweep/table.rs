@@ -285,6 +285,11 @@ fn chart(sweep: &Sweep, columns: &[String], rows: &[Row]) -> Result<Chart, Strin
         series[at].1.push((xv, yv));
         series[at].2.push(get(&error_column).unwrap_or(0.0));
     }
+    // The legend goes where the data are not: to the left when y rises with x.
+    let points = || series.iter().flat_map(|(_, p, _)| p.iter().copied());
+    let leftmost = points().min_by(|a, b| a.0.total_cmp(&b.0));
+    let rightmost = points().max_by(|a, b| a.0.total_cmp(&b.0));
+    let rises = matches!((leftmost, rightmost), (Some(l), Some(r)) if r.1 > l.1);
     let series = series
         .into_iter()
         .map(
@@ -298,6 +303,6 @@ fn chart(sweep: &Sweep, columns: &[String], rows: &[Row]) -> Result<Chart, Strin
         x_label: x.clone(),
         y_label: if has_errors { format!("{y} (± one standard error)") } else { y.clone() },
         series,
-        legend_left: false,
+        legend_left: rises,
     })
 }
