@@ -468,8 +468,6 @@ fn run_simulation(args: RunArgs) -> Result<ExitCode> {
     use collide::run::config::{Config, DEFAULT_CONFIG};
     use collide::run::output::{AnyCheckpoint, RunFailure, RunOptions, Start, load_any_checkpoint, run_into};
     use collide::run::{Phase, Status};
-    use std::sync::Arc;
-    use std::sync::atomic::AtomicBool;
     if args.print_default {
         say!("{}", DEFAULT_CONFIG.trim_end());
         return Ok(ExitCode::SUCCESS);
@@ -493,11 +491,7 @@ fn run_simulation(args: RunArgs) -> Result<ExitCode> {
         }
         bar.set_position((done.clamp(0.0, 1.0) * 1000.0) as u64);
     };
-    // SIGINT and SIGTERM set the flag; the run stops at its next event and saves itself.
-    let stop = Arc::new(AtomicBool::new(false));
-    for signal in [signal_hook::consts::SIGINT, signal_hook::consts::SIGTERM] {
-        signal_hook::flag::register(signal, Arc::clone(&stop)).context("installing the signal handlers")?;
-    }
+    let stop = stop_on_signals()?;
     let options = RunOptions { force: args.force, interrupt_after: args.interrupt_after };
     // The run's dimension decides the engine's: a configuration's `dimension`, or that of the
     // run a checkpoint holds.
@@ -544,16 +538,9 @@ fn run_simulation(args: RunArgs) -> Result<ExitCode> {
             );
             return Ok(ExitCode::from(130));
         }
-        Status::Stalled => {
-            let why = summary.stall.as_ref().map_or_else(String::new, |s| s.to_string());
-            eprintln!("collide: {source}: stopped: {why}; results so far in {out}");
-            return Ok(ExitCode::FAILURE);
-        }
-        Status::TooManySamples => {
-            eprintln!(
-                "collide: {source}: stopped at {} samples, the most a run keeps: use a larger run.sample_interval; results so far in {out}",
-                summary.samples
-            );
+        Status::Stalled | Status::TooManySamples => {
+            let problem = summary.problem().unwrap_or_default();
+            eprintln!("collide: {source}: {problem}; results so far in {out}");
             return Ok(ExitCode::FAILURE);
         }
         _ => {}
@@ -573,7 +560,7 @@ fn run_simulation(args: RunArgs) -> Result<ExitCode> {
             c.max_overlap
         );
         if summary.status == Status::Jammed {
-            eprintln!("collide: {source}: the packing jammed before its target packing fraction; results in {out}");
+            eprintln!("collide: {source}: {}; results in {out}", summary.problem().unwrap_or_default());
             return Ok(ExitCode::FAILURE);
         }
         if summary.config.compress.as_ref().is_some_and(|c| c.to_jamming()) {
@@ -598,20 +585,26 @@ fn run_simulation(args: RunArgs) -> Result<ExitCode> {
     Ok(ExitCode::SUCCESS)
 }
 
-fn sweep(args: SweepArgs) -> Result<ExitCode> {
-    use collide::sweep::local::{self, Ended, Progress};
-    use collide::sweep::task::{self, Outcome, State};
-    use collide::sweep::{Sweep, slurm, table};
+/// A flag that SIGINT and SIGTERM set: a run stops at its next event and saves itself.
+fn stop_on_signals() -> Result<std::sync::Arc<std::sync::atomic::AtomicBool>> {
     use std::sync::Arc;
     use std::sync::atomic::AtomicBool;
-    let sweep = Sweep::load(&args.sweep)?;
-    let tasks = sweep.tasks()?;
-    let n = tasks.len();
-    let out = &args.out;
     let stop = Arc::new(AtomicBool::new(false));
     for signal in [signal_hook::consts::SIGINT, signal_hook::consts::SIGTERM] {
         signal_hook::flag::register(signal, Arc::clone(&stop)).context("installing the signal handlers")?;
     }
+    Ok(stop)
+}
+
+fn sweep(args: SweepArgs) -> Result<ExitCode> {
+    use collide::sweep::local::{self, Ended, Progress};
+    use collide::sweep::task::{self, Outcome, State};
+    use collide::sweep::{Sweep, slurm, table};
+    let sweep = Sweep::load(&args.sweep)?;
+    let tasks = sweep.tasks()?;
+    let n = tasks.len();
+    let out = &args.out;
+    let stop = stop_on_signals()?;
     if let Some(k) = args.task {
         let Some(t) = tasks.get(k) else {
             bail!("--task {k}: {} makes {n} tasks, numbered 0 to {}", sweep.source, n - 1);

@@ -280,6 +280,11 @@ impl Rdf {
 
     /// The ideal-gas pair counts of species pair `q`, bin by bin (see the module docs).
     pub fn ideal(&self, q: usize) -> Vec<f64> {
+        self.ideal_bins(q, 0..self.bins)
+    }
+
+    /// [`ideal`](Self::ideal) for the bins `bins` only (a contact window's, at the start).
+    fn ideal_bins(&self, q: usize, bins: std::ops::Range<usize>) -> Vec<f64> {
         let [a, b] = self.pairs[q];
         let (ka, kb) = (self.kinds[a as usize], self.kinds[b as usize]);
         let pairs =
@@ -292,27 +297,26 @@ impl Rdf {
         let volume = |l: &[f64]| l.iter().product::<f64>();
         let norm = pairs / (volume(&la) * volume(&lb));
         let walled = self.periodic.iter().any(|p| !p);
-        (0..self.bins)
-            .map(|k| {
-                let (r0, r1) = self.edges(k);
-                if !walled {
-                    let unit = unit_ball(d);
-                    return pairs * unit * (r1.powi(d as i32) - r0.powi(d as i32)) / volume(&la);
-                }
-                norm * shell_integral(d, r0, r1, |h| {
-                    (0..d)
-                        .map(|i| {
-                            if self.periodic[i] {
-                                self.lengths[i]
-                            } else {
-                                let (x, y) = (la[i], lb[i]);
-                                x.min(y).min(0.5 * (x + y) - h[i].abs()).max(0.0)
-                            }
-                        })
-                        .product()
-                })
+        bins.map(|k| {
+            let (r0, r1) = self.edges(k);
+            if !walled {
+                let unit = unit_ball(d);
+                return pairs * unit * (r1.powi(d as i32) - r0.powi(d as i32)) / volume(&la);
+            }
+            norm * shell_integral(d, r0, r1, |h| {
+                (0..d)
+                    .map(|i| {
+                        if self.periodic[i] {
+                            self.lengths[i]
+                        } else {
+                            let (x, y) = (la[i], lb[i]);
+                            x.min(y).min(0.5 * (x + y) - h[i].abs()).max(0.0)
+                        }
+                    })
+                    .product()
             })
-            .collect()
+        })
+        .collect()
     }
 
     /// `g` of species pair `q`, bin by bin (NaN before the first sample).
@@ -345,8 +349,8 @@ impl Rdf {
                 // Column j of the solution: the quadratic fitted to the unit vector e_j;
                 // its value at contact (u = 0) is its constant term.
                 let fitted = x.qr().solve_lstsq(&identity);
-                let ideal = self.ideal(q);
-                Some(Window { first, weights: (0..n).map(|j| fitted[(0, j)] / ideal[first + j]).collect() })
+                let ideal = self.ideal_bins(q, first..first + n);
+                Some(Window { first, weights: (0..n).map(|j| fitted[(0, j)] / ideal[j]).collect() })
             })
             .collect()
     }

@@ -213,6 +213,25 @@ pub struct Summary {
     pub config: super::Config,
 }
 
+impl Summary {
+    /// What is wrong with a run that ended but did not complete — the watchdog stopped it,
+    /// it filled its samples, its compression jammed early — as `collide run` and a sweep's
+    /// `failed.json` say it (`None`: it completed, or was interrupted and continues).
+    pub fn problem(&self) -> Option<String> {
+        match self.status {
+            Status::Complete | Status::Interrupted => None,
+            Status::Stalled => {
+                Some(format!("stopped: {}", self.stall.as_ref().map_or_else(String::new, |s| s.to_string())))
+            }
+            Status::TooManySamples => Some(format!(
+                "stopped at {} samples, the most a run keeps: use a larger run.sample_interval",
+                self.samples
+            )),
+            Status::Jammed => Some("the packing jammed before its target packing fraction".to_string()),
+        }
+    }
+}
+
 fn production() -> Phase {
     Phase::Production
 }

@@ -218,12 +218,7 @@ fn json(sweep: &Sweep, keys: &[String], rows: &[Row]) -> String {
             o.insert("task".into(), row.index.into());
             o.insert("dir".into(), row.dir.clone().into());
             o.insert("status".into(), row.state.name().into());
-            let parameters: Map<String, Json> = row
-                .parameters
-                .iter()
-                .map(|(k, v)| (k.clone(), serde_json::to_value(v).unwrap_or(Json::Null)))
-                .collect();
-            o.insert("parameters".into(), parameters.into());
+            o.insert("parameters".into(), task::parameters_json(&row.parameters).into());
             o.insert("results".into(), row.results.iter().cloned().collect::<Map<String, Json>>().into());
             let error = error_of(row);
             o.insert("error".into(), if error.is_empty() { Json::Null } else { error.into() });

@@ -15,12 +15,13 @@
 //! file was edited): the task counts as not started and runs afresh.
 
 use super::{SweepError, Task};
-use crate::run::output::{AnyCheckpoint, RunFailure, RunOptions, Start, load_any_checkpoint, run_into};
+use crate::run::output::{AnyCheckpoint, RunOptions, Start, load_any_checkpoint, run_into};
 use crate::run::rundir::{OutputError, RunDir, write_atomic};
 use crate::run::{Status, Summary};
 use serde::{Deserialize, Serialize};
 use std::path::{Path, PathBuf};
 use std::sync::atomic::AtomicBool;
+use toml::Value;
 
 /// The task's record.
 pub const RECORD: &str = "task.json";
@@ -87,12 +88,9 @@ struct Failure {
     error: String,
 }
 
-/// The varied values as JSON.
-pub(crate) fn parameters_json(task: &Task) -> serde_json::Map<String, serde_json::Value> {
-    task.parameters
-        .iter()
-        .map(|(k, v)| (k.clone(), serde_json::to_value(v).unwrap_or(serde_json::Value::Null)))
-        .collect()
+/// Varied values (a task's `parameters`) as JSON.
+pub(crate) fn parameters_json(parameters: &[(String, Value)]) -> serde_json::Map<String, serde_json::Value> {
+    parameters.iter().map(|(k, v)| (k.clone(), serde_json::to_value(v).unwrap_or(serde_json::Value::Null))).collect()
 }
 
 /// The task's directory under the sweep's output directory `out`.
@@ -100,10 +98,24 @@ pub fn dir(out: &Path, task: &Task, n_tasks: usize) -> PathBuf {
     out.join("tasks").join(task.dir_name(n_tasks))
 }
 
+/// Whether `dir`'s `task.json` is `task`'s: its number and its configuration's digest.
+fn recorded(dir: &Path, task: &Task) -> bool {
+    std::fs::read(dir.join(RECORD))
+        .ok()
+        .and_then(|b| serde_json::from_slice::<Record>(&b).ok())
+        .is_some_and(|r| r.digest == task.digest && r.index == task.index)
+}
+
+/// Writes `failed.json` for `task` into `dir`.
+fn write_failure(task: &Task, dir: &Path, error: &str) -> Result<(), SweepError> {
+    let failure = Failure { index: task.index, error: error.to_string() };
+    write_atomic(&dir.join(FAILED), serde_json::to_string_pretty(&failure).expect("serialises").as_bytes())?;
+    Ok(())
+}
+
 /// The state of `task`, from the files in its directory `dir`.
 pub fn state(dir: &Path, task: &Task) -> State {
-    let record: Option<Record> = std::fs::read(dir.join(RECORD)).ok().and_then(|b| serde_json::from_slice(&b).ok());
-    if record.is_none_or(|r| r.digest != task.digest || r.index != task.index) {
+    if !recorded(dir, task) {
         return State::NotFinished;
     }
     if let Some(failure) = std::fs::read(dir.join(FAILED)).ok().and_then(|b| serde_json::from_slice::<Failure>(&b).ok())
@@ -123,23 +135,6 @@ pub fn state(dir: &Path, task: &Task) -> State {
         Some("interrupted") => State::NotFinished,
         // Recorded in failed.json when the run ended so; this is a summary without it.
         Some(other) => State::Failed(format!("the run ended {other}")),
-    }
-}
-
-/// What is wrong with a run that ended with a summary but did not complete, as `collide run`
-/// says it (`None`: it completed, or was interrupted).
-pub fn problem(summary: &Summary) -> Option<String> {
-    match summary.status {
-        Status::Complete | Status::Interrupted => None,
-        Status::Stalled => Some(format!(
-            "stopped: {}",
-            summary.stall.as_ref().map_or_else(|| "the watchdog stopped it".to_string(), |s| s.to_string())
-        )),
-        Status::TooManySamples => Some(format!(
-            "stopped at {} samples, the most a run keeps: use a larger run.sample_interval",
-            summary.samples
-        )),
-        Status::Jammed => Some("the packing jammed before its target packing fraction".to_string()),
     }
 }
 
@@ -195,7 +190,11 @@ pub fn run(task: &Task, dir: &Path, retry_failed: bool, stop: &AtomicBool) -> Re
             }
             let header = format!("# collide sweep, task {}: {}\n", task.index, task.label());
             write_atomic(&dir.join(CONFIG), format!("{header}{}", task.text).as_bytes())?;
-            let record = Record { index: task.index, parameters: parameters_json(task), digest: task.digest.clone() };
+            let record = Record {
+                index: task.index,
+                parameters: parameters_json(&task.parameters),
+                digest: task.digest.clone(),
+            };
             write_atomic(&dir.join(RECORD), serde_json::to_string_pretty(&record).expect("serialises").as_bytes())?;
             let options = RunOptions { force: true, interrupt_after: None };
             let config = task.config.clone();
@@ -205,20 +204,16 @@ pub fn run(task: &Task, dir: &Path, retry_failed: bool, stop: &AtomicBool) -> Re
             }
         }
     };
-    let failed = |error: String| -> Result<Outcome, SweepError> {
-        let failure = Failure { index: task.index, error: error.clone() };
-        write_atomic(&dir.join(FAILED), serde_json::to_string_pretty(&failure).expect("serialises").as_bytes())?;
-        Ok(Outcome::Failed(error))
-    };
-    match ran {
-        Ok(summary) if summary.status == Status::Interrupted => Ok(Outcome::Interrupted),
-        Ok(summary) => match problem(&summary) {
-            Some(problem) => failed(problem),
-            None => Ok(Outcome::Finished(Box::new(summary))),
+    let error = match ran {
+        Ok(summary) if summary.status == Status::Interrupted => return Ok(Outcome::Interrupted),
+        Ok(summary) => match summary.problem() {
+            Some(problem) => problem,
+            None => return Ok(Outcome::Finished(Box::new(summary))),
         },
-        Err(RunFailure::Run(e)) => failed(e.to_string()),
-        Err(e) => failed(e.to_string()),
-    }
+        Err(e) => e.to_string(),
+    };
+    write_failure(task, dir, &error)?;
+    Ok(Outcome::Failed(error))
 }
 
 /// Records a failure the task's own process could not record (it was killed, or crashed):
@@ -229,14 +224,8 @@ pub fn record_failure(task: &Task, dir: &Path, error: &str) -> Result<(), SweepE
     if matches!(RunDir::open(dir, false, Some(dir)), Err(OutputError::Locked { .. })) {
         return Ok(());
     }
-    if state(dir, task) == State::NotFinished
-        && std::fs::read(dir.join(RECORD))
-            .ok()
-            .and_then(|b| serde_json::from_slice::<Record>(&b).ok())
-            .is_some_and(|r| r.digest == task.digest)
-    {
-        let failure = Failure { index: task.index, error: error.to_string() };
-        write_atomic(&dir.join(FAILED), serde_json::to_string_pretty(&failure).expect("serialises").as_bytes())?;
+    if recorded(dir, task) && state(dir, task) == State::NotFinished {
+        write_failure(task, dir, error)?;
     }
     Ok(())
 }
@@ -285,7 +274,7 @@ pub fn write_manifest(out: &Path, source: &str, keys: &[String], tasks: &[Task])
             .map(|t| ManifestTask {
                 index: t.index,
                 dir: format!("tasks/{}", t.dir_name(n)),
-                parameters: parameters_json(t),
+                parameters: parameters_json(&t.parameters),
                 digest: t.digest.clone(),
             })
             .collect(),
