@@ -155,7 +155,8 @@ struct RunArgs {
     #[arg(long, default_value = "collide-out")]
     out: PathBuf,
     /// Replace the files of an earlier run in the output directory (only those:
-    /// summary.json, timeseries.csv, trajectory.xyz, checkpoint.json, rdf.csv).
+    /// summary.json, timeseries.csv, trajectory.xyz, checkpoint.json and the observables'
+    /// files: rdf.csv, msd.csv, vacf.csv).
     #[arg(long)]
     force: bool,
     /// No progress bar (it is drawn only on a terminal, and never when CI is set).

@@ -10,7 +10,9 @@
 //!   series (every run has it; its estimators are specified in [`thermo`]).
 //! * The registered observables a configuration names under `[observe.<name>]`
 //!   ([`Selection`]): [`velocities`] (the velocity distribution against the Maxwellian),
-//!   [`rdf`] (g(r) per species pair and its contact value). An observable that samples at
+//!   [`rdf`] (g(r) per species pair and its contact value), [`msd`] and [`vacf`] (the mean
+//!   squared displacement and the velocity autocorrelation over many time origins, by the
+//!   multiple-tau scheme of [`correlator`], and the diffusion coefficient from each). An observable that samples at
 //!   instants of its own (every `every` time units) says when it is next
 //!   [due](Observable::due); the run hands it the particles at that instant, before the
 //!   event that follows it ([`Observable::sample`]), and writes its own files at the end
@@ -30,9 +32,12 @@
 
 pub mod blocks;
 pub mod contacts;
+pub mod correlator;
+pub mod msd;
 pub mod order;
 pub mod rdf;
 pub mod thermo;
+pub mod vacf;
 pub mod velocities;
 
 pub use blocks::block_error;
@@ -59,6 +64,12 @@ pub struct Selection {
     /// The radial distribution function ([`rdf`]).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub rdf: Option<rdf::Options>,
+    /// The mean squared displacement ([`msd`]).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub msd: Option<msd::Options>,
+    /// The velocity autocorrelation ([`vacf`]).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub vacf: Option<vacf::Options>,
 }
 
 impl Selection {
@@ -72,6 +83,12 @@ impl Selection {
         if let Some(options) = &self.rdf {
             options.check()?;
         }
+        if let Some(options) = &self.msd {
+            options.check("msd")?;
+        }
+        if let Some(options) = &self.vacf {
+            options.check("vacf")?;
+        }
         Ok(())
     }
 
@@ -84,6 +101,12 @@ impl Selection {
         if let Some(options) = &self.rdf {
             out.push(Observable::Rdf(rdf::Rdf::new(sim, options.clone())));
         }
+        if let Some(options) = &self.msd {
+            out.push(Observable::Msd(msd::Msd::new(sim, options.clone())));
+        }
+        if let Some(options) = &self.vacf {
+            out.push(Observable::Vacf(vacf::Vacf::new(sim, options.clone())));
+        }
         out
     }
 
@@ -95,6 +118,12 @@ impl Selection {
         }
         if self.rdf.is_some() {
             out.push("rdf");
+        }
+        if self.msd.is_some() {
+            out.push("msd");
+        }
+        if self.vacf.is_some() {
+            out.push("vacf");
         }
         out
     }
@@ -109,6 +138,10 @@ pub enum Observable {
     Velocities(velocities::Velocities),
     /// g(r).
     Rdf(rdf::Rdf),
+    /// The mean squared displacement.
+    Msd(msd::Msd),
+    /// The velocity autocorrelation.
+    Vacf(vacf::Vacf),
 }
 
 impl Observable {
@@ -117,6 +150,8 @@ impl Observable {
         match self {
             Observable::Velocities(_) => "velocities",
             Observable::Rdf(_) => "rdf",
+            Observable::Msd(_) => "msd",
+            Observable::Vacf(_) => "vacf",
         }
     }
 
@@ -125,6 +160,8 @@ impl Observable {
         match self {
             Observable::Velocities(v) => serde_json::to_value(v),
             Observable::Rdf(g) => serde_json::to_value(g.results()),
+            Observable::Msd(m) => serde_json::to_value(m.results()),
+            Observable::Vacf(c) => serde_json::to_value(c.results()),
         }
         .expect("results serialise")
     }
@@ -134,6 +171,8 @@ impl Observable {
         match self {
             Observable::Velocities(v) => v.dimension,
             Observable::Rdf(g) => g.dimension,
+            Observable::Msd(m) => m.dimension,
+            Observable::Vacf(c) => c.dimension,
         }
     }
 
@@ -143,6 +182,8 @@ impl Observable {
         match self {
             Observable::Velocities(_) => None,
             Observable::Rdf(g) => Some(g.due()),
+            Observable::Msd(m) => Some(m.due()),
+            Observable::Vacf(c) => Some(c.due()),
         }
     }
 
@@ -152,6 +193,8 @@ impl Observable {
         match self {
             Observable::Velocities(_) => {}
             Observable::Rdf(g) => g.sample(sim.particles(), sim.sim_box(), t),
+            Observable::Msd(m) => m.sample(sim.particles(), t),
+            Observable::Vacf(c) => c.sample(sim.particles(), t),
         }
     }
 
@@ -160,6 +203,8 @@ impl Observable {
         match self {
             Observable::Velocities(_) => Vec::new(),
             Observable::Rdf(g) => vec![("rdf.csv", g.csv())],
+            Observable::Msd(m) => vec![("msd.csv", m.csv())],
+            Observable::Vacf(c) => vec![("vacf.csv", c.csv())],
         }
     }
 }
@@ -170,6 +215,8 @@ impl<const D: usize> Observer<D> for Observable {
         match self {
             Observable::Velocities(v) => v.observe(sim, outcome),
             Observable::Rdf(g) => g.observe(sim, outcome),
+            Observable::Msd(m) => m.observe(sim, outcome),
+            Observable::Vacf(c) => c.observe(sim, outcome),
         }
     }
 }

@@ -65,10 +65,23 @@ impl Limits {
     /// The memory `n` particles and `samples` samples take ([`BYTES_PER_PARTICLE`],
     /// [`BYTES_PER_SAMPLE`]), if this machine has it; `field` names what asks for them.
     pub fn check_memory(&self, field: &'static str, n: usize, samples: f64) -> Result<f64, LimitError> {
-        let needed = n as f64 * BYTES_PER_PARTICLE as f64 + samples * BYTES_PER_SAMPLE as f64;
+        self.check_memory_with(field, n, samples, 0.0)
+    }
+
+    /// [`check_memory`](Self::check_memory) with `observers` more bytes per particle (the
+    /// observables' own: the MSD's and VACF's stored samples).
+    pub fn check_memory_with(
+        &self,
+        field: &'static str,
+        n: usize,
+        samples: f64,
+        observers: f64,
+    ) -> Result<f64, LimitError> {
+        let per_particle = BYTES_PER_PARTICLE as f64 + observers;
+        let needed = n as f64 * per_particle + samples * BYTES_PER_SAMPLE as f64;
         match self.memory {
             Some(available) if needed > available as f64 => {
-                Err(LimitError::Memory { field, n, samples, needed, available })
+                Err(LimitError::Memory { field, n, samples, needed, available, per_particle })
             }
             _ => Ok(needed),
         }
@@ -131,6 +144,8 @@ pub enum LimitError {
         needed: f64,
         /// Bytes available.
         available: u64,
+        /// Bytes per particle (the engine's and the observables').
+        per_particle: f64,
     },
     /// A run length that asks for, or would take, too many collisions.
     Collisions {
@@ -162,15 +177,20 @@ impl fmt::Display for LimitError {
             LimitError::TooManyParticles { n, max } => {
                 write!(f, "species: {n} particles in all; the engine takes at most {max}")
             }
-            LimitError::Memory { field, n, samples, needed, available } => {
+            LimitError::Memory { field, n, samples, needed, available, per_particle } => {
                 write!(f, "{field}: {n} particles")?;
                 if *samples >= 1.0 {
                     write!(f, " and about {samples:.3e} samples")?;
                 }
                 write!(
                     f,
-                    " need about {:.3} GB of memory ({BYTES_PER_PARTICLE} bytes per particle, {BYTES_PER_SAMPLE} per sample); this machine has {:.3} GB available",
+                    " need about {:.3} GB of memory ({per_particle:.0} bytes per particle{}, {BYTES_PER_SAMPLE} per sample); this machine has {:.3} GB available",
                     needed / 1e9,
+                    if *per_particle > BYTES_PER_PARTICLE as f64 {
+                        " with the observables' stored samples"
+                    } else {
+                        ""
+                    },
                     *available as f64 / 1e9
                 )
             }
@@ -250,6 +270,19 @@ pub fn check<const D: usize>(config: &Config, volume: f64, limits: &Limits) -> R
             max: limits.max_samples,
         });
     }
-    let memory = limits.check_memory("species", n, samples)?;
+    // The MSD's and VACF's stored samples, at their default or asked-for rates.
+    let observers: f64 = [
+        (config.observe.msd.as_ref(), crate::observe::correlator::Kind::Displacement),
+        (config.observe.vacf.as_ref(), crate::observe::correlator::Kind::Velocity),
+    ]
+    .into_iter()
+    .filter_map(|(options, kind)| {
+        let options = options?;
+        let every = options.every.unwrap_or(1.0 / rate);
+        let max_lag = options.max_lag.unwrap_or(crate::observe::msd::LAGS * every);
+        Some(crate::observe::correlator::bytes_per_particle(kind, D, every, max_lag))
+    })
+    .sum();
+    let memory = limits.check_memory_with("species", n, samples, observers)?;
     Ok(Estimate { rate_per_particle: rate, production_time, production_collisions, samples, memory })
 }
