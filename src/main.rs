@@ -156,7 +156,7 @@ struct RunArgs {
     out: PathBuf,
     /// Replace the files of an earlier run in the output directory (only those:
     /// summary.json, timeseries.csv, trajectory.xyz, checkpoint.json and the observables'
-    /// files: rdf.csv, msd.csv, vacf.csv).
+    /// files: rdf.csv, msd.csv, vacf.csv, sk.csv, bond_order.csv, g6.csv).
     #[arg(long)]
     force: bool,
     /// No progress bar (it is drawn only on a terminal, and never when CI is set).

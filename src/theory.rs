@@ -14,6 +14,9 @@
 //! | [`z_carnahan_starling`], [`g_carnahan_starling`] | 3 | to about 0.3 % over the fluid branch |
 //! | [`enskog_rate`] | 2, 3 | exact at low density, with g(σ) the contact value |
 //! | [`mean_free_path_enskog`] | 2, 3 | with Enskog's rate |
+//! | [`enskog_diffusion`], [`enskog_viscosity`] | 2, 3 | exact at low density (first Sonine approximation) |
+//! | [`tail_amplitude`] | 2, 3 | the VACF at times long against the mean free time, short against L/c |
+//! | [`sound_speed`] | 2, 3 | with the equation of state given |
 
 use std::f64::consts::PI;
 
@@ -173,6 +176,45 @@ pub fn mean_free_path_enskog(eta: f64) -> f64 {
     1.0 / (2.0 * 2f64.sqrt() * 4.0 * eta / PI * g_henderson(eta))
 }
 
+/// Enskog's self-diffusion coefficient of `d`-dimensional hard spheres at number density `n`
+/// with contact value `g` (σ = m = kT = 1; first Sonine approximation): `D_E = D₀/g`,
+/// `D₀ = 1/(2n)·√(1/π)` in 2D and `3/(8n)·√(1/π)` in 3D (Chapman & Cowling, 3rd ed. (1970),
+/// §16.5; Gass, J. Chem. Phys. 54, 1898 (1971) for disks).
+pub fn enskog_diffusion(d: usize, n: f64, g: f64) -> f64 {
+    let d0 = if d == 2 { 1.0 / (2.0 * n) } else { 3.0 / (8.0 * n) } / PI.sqrt();
+    d0 / g
+}
+
+/// Enskog's shear viscosity of `d`-dimensional hard spheres at packing fraction `eta` with
+/// contact value `g` (σ = m = kT = 1; first Sonine approximation): `η_E/η₀ =
+/// (1/g)(1 + 2^d·η·g/(d + 2))² + d/(d + 2)·2^(2d+2)/(π(d + 2))·η²g`, with `η₀ = 1/(2√π)` in 2D
+/// and `5/(16√π)` in 3D — the elastic limit of Garzó & Dufty, Phys. Rev. E 59, 5895 (1999),
+/// Eqs. 40–44; in 3D it is Enskog's `1/g + 3.2η + 12.34η²g` (Chapman & Cowling §16.41), in
+/// 2D Gass's `1/g + 2η + (1 + 8/π)η²g`.
+pub fn enskog_viscosity(d: usize, eta: f64, g: f64) -> f64 {
+    let df = d as f64;
+    let eta0 = if d == 2 { 0.5 } else { 5.0 / 16.0 } / PI.sqrt();
+    let kinetic = (1.0 + 2f64.powi(d as i32) * eta * g / (df + 2.0)).powi(2) / g;
+    let bulk = df / (df + 2.0) * 2f64.powi(2 * d as i32 + 2) / (PI * (df + 2.0)) * eta * eta * g;
+    eta0 * (kinetic + bulk)
+}
+
+/// The amplitude `A` of the velocity autocorrelation's long-time tail,
+/// `C(t)/C(0) ≈ A·t^(−d/2)`, by mode coupling: `A = (d − 1)/(d·n)·[4π(D + ν)]^(−d/2)`, `ν =
+/// η_s/(mn)` the kinematic viscosity (Ernst, Hauge & van Leeuwen, Phys. Rev. A 4, 2055
+/// (1971); Dorfman & Cohen, Phys. Rev. A 6, 776 (1972)); σ = m = kT = 1.
+pub fn tail_amplitude(d: usize, n: f64, diffusion: f64, viscosity: f64) -> f64 {
+    let df = d as f64;
+    (df - 1.0) / (df * n) * (4.0 * PI * (diffusion + viscosity / n)).powf(-df / 2.0)
+}
+
+/// The adiabatic sound speed of hard particles with equation of state `Z(η)`:
+/// `c² = (kT/m)[d(ηZ)/dη + (2/d)Z²]` (`∂P/∂n` at fixed T plus the heat term of a gas of
+/// `d/2·k` heat capacity per particle), from `z` and its derivative `dz` at `eta`.
+pub fn sound_speed(d: usize, eta: f64, z: f64, dz: f64) -> f64 {
+    (z + eta * dz + 2.0 / d as f64 * z * z).sqrt()
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -195,6 +237,17 @@ mod tests {
         // Enskog's rate, 2D against the explicit form; 3D: 4nσ²g√π.
         assert_eq!(enskog_rate(2, 0.3, 1.0, 1.5, 1.0, 1.0), enskog_rate_2d(0.3, 1.0, 1.5, 1.0, 1.0));
         assert!((enskog_rate(3, 0.5, 1.0, 2.0, 1.0, 1.0) - 4.0 * PI.sqrt()).abs() < 1e-14);
+        // Enskog's viscosity in 3D is 1/g + 3.2η + (4/25)(1 + 12/π)·16η²g times η₀; in 2D
+        // 1/g + 2η + (1 + 8/π)η²g times η₀ = 1/(2√π).
+        let (eta, g) = (0.3, 2.5);
+        let e3 = 5.0 / 16.0 / PI.sqrt() * (1.0 / g + 3.2 * eta + 0.16 * (1.0 + 12.0 / PI) * 16.0 * eta * eta * g);
+        assert!((enskog_viscosity(3, eta, g) - e3).abs() < 1e-13 * e3);
+        let e2 = 0.5 / PI.sqrt() * (1.0 / g + 2.0 * eta + (1.0 + 8.0 / PI) * eta * eta * g);
+        assert!((enskog_viscosity(2, eta, g) - e2).abs() < 1e-13 * e2);
+        // The 2D tail: 1/(8πn(D + ν)).
+        assert!((tail_amplitude(2, 0.4, 0.3, 0.2) - 1.0 / (8.0 * PI * 0.4 * 0.8)).abs() < 1e-15);
+        // An ideal gas (Z = 1): c² = (1 + 2/d)kT/m, γ = (d + 2)/d.
+        assert!((sound_speed(3, 0.1, 1.0, 0.0) - (5.0f64 / 3.0).sqrt()).abs() < 1e-15);
         // Mean free path times rate is the mean speed √(π/2).
         let eta = 0.2;
         assert!((mean_free_path_enskog(eta) * gamma_enskog(eta, g_henderson(eta)) - (PI / 2.0).sqrt()).abs() < 1e-14);

@@ -507,3 +507,53 @@ fn jamming_checks_can_fail() {
     overlapping[3].max_overlap = 1e-9;
     failing_only(6, verdicts(&overlapping, &crystal));
 }
+
+#[test]
+fn structure_diffusion_and_long_time_tail_quick_pass() {
+    use collide::lab::{diffusion, long_time_tail, structure};
+    for name in [structure::NAME, diffusion::NAME, long_time_tail::NAME] {
+        let (result, dir) = quick(name);
+        assert!(result.passed(), "{}", collide::lab::check::table(name, &result.checks));
+        assert_svgs(&result, dir);
+    }
+}
+
+/// The structure, diffusion and tail checks pass on their own quick data and fail on it made
+/// wrong by a few standard errors (or, for the tail, by a slope of −0.2 or −2 or an amplitude
+/// halved).
+#[test]
+fn structure_diffusion_and_long_time_tail_checks_can_fail() {
+    use collide::lab::diffusion::{DiffusionState, checks_for as diffusion_checks};
+    use collide::lab::structure::{StructureState, checks_for as structure_checks};
+    let (result, _) = quick("structure");
+    for state in result.data["states"].as_array().unwrap() {
+        let s: StructureState = serde_json::from_value(state.clone()).unwrap();
+        assert!(structure_checks(&s).iter().all(|c| c.pass));
+        let g = StructureState { g_contact: s.g_contact + 6.0 * s.g_contact_err.hypot(s.g_pressure_err), ..s.clone() };
+        let verdicts: Vec<bool> = structure_checks(&g).iter().map(|c| c.pass).collect();
+        assert_eq!(verdicts, [false, false, true], "η = {}", s.eta);
+        let s0 = StructureState { s0: s.s0 - 6.0 * s.s0_err - 0.01 * s.s0_reference, ..s.clone() };
+        assert!(!structure_checks(&s0)[2].pass, "η = {}", s.eta);
+    }
+    let (result, _) = quick("diffusion");
+    for state in result.data["states"].as_array().unwrap() {
+        let s: DiffusionState = serde_json::from_value(state.clone()).unwrap();
+        assert!(diffusion_checks(2, &s).iter().all(|c| c.pass));
+        let wrong = DiffusionState { difference: 6.0 * s.difference_err + 0.002 * s.d_gk_mean, ..s.clone() };
+        assert!(!diffusion_checks(2, &wrong)[0].pass);
+        let flat = DiffusionState { log_slope: 2.0 * s.log_slope_err, ..s.clone() };
+        assert!(!diffusion_checks(2, &flat)[1].pass);
+    }
+    let (result, _) = quick("long_time_tail");
+    let checks = |slope: f64, amplitude: f64| -> Vec<bool> {
+        let mut tail: collide::lab::long_time_tail::Tail = serde_json::from_value(result.data.clone()).unwrap();
+        (tail.slope, tail.amplitude) = (slope, amplitude);
+        collide::lab::long_time_tail::checks(2, &tail).iter().map(|c| c.pass).collect()
+    };
+    let tail: collide::lab::long_time_tail::Tail = serde_json::from_value(result.data.clone()).unwrap();
+    assert_eq!(checks(tail.slope, tail.amplitude), [true, true]);
+    let t = collide::lab::stats::three_sigma_factor(20);
+    assert!(!checks(-1.0 + 1.05 * (t * tail.slope_err + 0.1), tail.amplitude)[0]);
+    assert!(!checks(-0.2, tail.amplitude)[0] && !checks(-2.0, tail.amplitude)[0]);
+    assert!(!checks(tail.slope, 0.5 * tail.amplitude_theory - t * tail.amplitude_err)[1]);
+}

@@ -19,13 +19,16 @@
 
 pub mod check;
 pub mod collision_rate;
+pub mod diffusion;
 pub mod equation_of_state;
 pub mod equipartition;
 pub mod jamming;
+pub mod long_time_tail;
 pub mod maxwell_boltzmann;
 pub mod plot;
 pub mod report;
 pub mod stats;
+pub mod structure;
 pub mod wall_pressure;
 
 pub use check::Check;
@@ -48,6 +51,9 @@ pub const EXPERIMENTS: &[(&str, Experiment)] = &[
     (collision_rate::NAME, collision_rate::run),
     (equipartition::NAME, equipartition::run),
     (jamming::NAME, jamming::run),
+    (structure::NAME, structure::run),
+    (diffusion::NAME, diffusion::run),
+    (long_time_tail::NAME, long_time_tail::run),
 ];
 
 /// Why an experiment could not finish (its checks failing is not an error: they are in the
@@ -125,6 +131,27 @@ pub fn run_to_end<const D: usize, S: crate::run::Sink<D, Error = std::convert::I
         return Err(ExperimentError::Stopped { at: run.sim.time() });
     }
     Ok(())
+}
+
+/// The configuration of a fluid of `n` unit-diameter particles of unit mass at packing
+/// fraction `eta` in a periodic box (`d` = 2: from the triangular lattice; 3: from the simple
+/// cubic one, which melts at once), `equilibration` collisions then `production`, followed
+/// by `observe` (TOML: the `[observe.*]` tables an experiment asks for).
+pub fn fluid_config(
+    d: usize,
+    eta: f64,
+    n: usize,
+    equilibration: u64,
+    production: u64,
+    seed: u64,
+    observe: &str,
+) -> String {
+    let placement = if d == 2 { "triangular" } else { "simple_cubic" };
+    format!(
+        "dimension = {d}\nseed = {seed}\n[box]\npacking_fraction = {eta}\nboundary = \"periodic\"\n\
+         [[species]]\ncount = {n}\nradius = 0.5\nmass = 1.0\n[init]\nplacement = \"{placement}\"\n\
+         [equilibration]\ncollisions = {equilibration}\n[run]\ncollisions = {production}\n{observe}"
+    )
 }
 
 /// How to run an experiment.

@@ -252,22 +252,37 @@ impl Correlator {
     /// A quantity `f` of the means (`mean(lag, species, channel)`), over all blocks, and its
     /// delete-one-block jackknife error (NaN with fewer than two blocks holding its lags).
     pub fn estimate(&self, f: impl Fn(&dyn Fn(usize, usize, usize) -> f64) -> f64) -> (f64, f64) {
-        let species = self.counts.len();
-        let mean_without = |skip: Option<usize>| {
+        self.estimate_with(self, |m, _| f(m))
+    }
+
+    /// A quantity `f` of the means of this correlator and of `other`, which took its samples
+    /// at the same instants (so that their blocks hold the same stretches of the run), and
+    /// its delete-one-block jackknife error: the error of a difference between the MSD and
+    /// the VACF, say, with their correlation accounted for.
+    pub fn estimate_with(
+        &self,
+        other: &Correlator,
+        f: impl Fn(&dyn Fn(usize, usize, usize) -> f64, &dyn Fn(usize, usize, usize) -> f64) -> f64,
+    ) -> (f64, f64) {
+        fn mean_without(of: &Correlator, skip: Option<usize>) -> impl Fn(usize, usize, usize) -> f64 + '_ {
+            let species = of.counts.len();
             move |k: usize, s: usize, c: usize| {
                 let (mut sum, mut origins) = (0.0, 0u64);
-                for b in 0..self.sums.len() {
+                for b in 0..of.sums.len() {
                     if Some(b) != skip {
-                        sum += self.sums[b][(k * species + s) * CHANNELS + c];
-                        origins += self.origins[b][k];
+                        sum += of.sums[b][(k * species + s) * CHANNELS + c];
+                        origins += of.origins[b][k];
                     }
                 }
-                sum / (origins as f64 * self.counts[s] as f64)
+                sum / (origins as f64 * of.counts[s] as f64)
             }
-        };
-        let all = f(&mean_without(None));
-        let partial: Vec<f64> =
-            (0..self.sums.len()).map(|b| f(&mean_without(Some(b)))).filter(|x| x.is_finite()).collect();
+        }
+        let blocks = if self.block_length == other.block_length { self.sums.len().min(other.sums.len()) } else { 0 };
+        let all = f(&mean_without(self, None), &mean_without(other, None));
+        let partial: Vec<f64> = (0..blocks)
+            .map(|b| f(&mean_without(self, Some(b)), &mean_without(other, Some(b))))
+            .filter(|x| x.is_finite())
+            .collect();
         let b = partial.len() as f64;
         if partial.len() < 2 {
             return (all, f64::NAN);
@@ -277,9 +292,14 @@ impl Correlator {
         (all, var.sqrt())
     }
 
-    /// The lag index of the longest lag with at least `origins` origins (None: none has).
+    /// The lag index of the longest lag a value is read at: averaged over at least `origins`
+    /// origins, and no longer than a block (`block_length · every`), so that the blocks of
+    /// its jackknife are nearly independent (None: no lag is).
     pub fn longest_lag(&self, origins: u64) -> Option<usize> {
-        (0..self.lag_count()).rev().find(|&k| self.origins.iter().map(|o| o[k]).sum::<u64>() >= origins)
+        let block = self.block_length as f64 * self.every;
+        (1..self.lag_count())
+            .rev()
+            .find(|&k| self.tau(k) <= block && self.origins.iter().map(|o| o[k]).sum::<u64>() >= origins)
     }
 }
 

@@ -12,7 +12,9 @@
 //!   ([`Selection`]): [`velocities`] (the velocity distribution against the Maxwellian),
 //!   [`rdf`] (g(r) per species pair and its contact value), [`msd`] and [`vacf`] (the mean
 //!   squared displacement and the velocity autocorrelation over many time origins, by the
-//!   multiple-tau scheme of [`correlator`], and the diffusion coefficient from each). An observable that samples at
+//!   multiple-tau scheme of [`correlator`], and the diffusion coefficient from each), [`sk`]
+//!   (the structure factor of a periodic box and its `k → 0` limit), [`bond_order`] (Ψ₆ and
+//!   g₆(r) of disks, Q₆ of spheres, along the run). An observable that samples at
 //!   instants of its own (every `every` time units) says when it is next
 //!   [due](Observable::due); the run hands it the particles at that instant, before the
 //!   event that follows it ([`Observable::sample`]), and writes its own files at the end
@@ -31,11 +33,13 @@
 //! [`Selection`], its variant of [`Observable`], and its line in each match below.
 
 pub mod blocks;
+pub mod bond_order;
 pub mod contacts;
 pub mod correlator;
 pub mod msd;
 pub mod order;
 pub mod rdf;
+pub mod sk;
 pub mod thermo;
 pub mod vacf;
 pub mod velocities;
@@ -70,6 +74,12 @@ pub struct Selection {
     /// The velocity autocorrelation ([`vacf`]).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub vacf: Option<vacf::Options>,
+    /// The structure factor ([`sk`]).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub sk: Option<sk::Options>,
+    /// Bond-orientational order: Ψ₆ and g₆(r) of disks, Q₆ of spheres ([`bond_order`]).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub bond_order: Option<bond_order::Options>,
 }
 
 impl Selection {
@@ -78,8 +88,9 @@ impl Selection {
         *self == Selection::default()
     }
 
-    /// Checks the options: the key, its value and what is allowed.
-    pub fn check(&self) -> Result<(), (String, String, String)> {
+    /// Checks the options for a box `periodic` along every axis or not: the key, its value
+    /// and what is allowed.
+    pub fn check(&self, periodic: bool) -> Result<(), (String, String, String)> {
         if let Some(options) = &self.rdf {
             options.check()?;
         }
@@ -88,6 +99,12 @@ impl Selection {
         }
         if let Some(options) = &self.vacf {
             options.check("vacf")?;
+        }
+        if let Some(options) = &self.sk {
+            options.check(periodic)?;
+        }
+        if let Some(options) = &self.bond_order {
+            options.check()?;
         }
         Ok(())
     }
@@ -107,6 +124,12 @@ impl Selection {
         if let Some(options) = &self.vacf {
             out.push(Observable::Vacf(vacf::Vacf::new(sim, options.clone())));
         }
+        if let Some(options) = &self.sk {
+            out.push(Observable::Sk(sk::Sk::new(sim, options.clone())));
+        }
+        if let Some(options) = &self.bond_order {
+            out.push(Observable::BondOrder(bond_order::BondOrder::new(sim, options.clone())));
+        }
         out
     }
 
@@ -125,6 +148,12 @@ impl Selection {
         if self.vacf.is_some() {
             out.push("vacf");
         }
+        if self.sk.is_some() {
+            out.push("sk");
+        }
+        if self.bond_order.is_some() {
+            out.push("bond_order");
+        }
         out
     }
 }
@@ -142,6 +171,10 @@ pub enum Observable {
     Msd(msd::Msd),
     /// The velocity autocorrelation.
     Vacf(vacf::Vacf),
+    /// The structure factor.
+    Sk(sk::Sk),
+    /// Bond-orientational order.
+    BondOrder(bond_order::BondOrder),
 }
 
 impl Observable {
@@ -152,6 +185,8 @@ impl Observable {
             Observable::Rdf(_) => "rdf",
             Observable::Msd(_) => "msd",
             Observable::Vacf(_) => "vacf",
+            Observable::Sk(_) => "sk",
+            Observable::BondOrder(_) => "bond_order",
         }
     }
 
@@ -162,6 +197,8 @@ impl Observable {
             Observable::Rdf(g) => serde_json::to_value(g.results()),
             Observable::Msd(m) => serde_json::to_value(m.results()),
             Observable::Vacf(c) => serde_json::to_value(c.results()),
+            Observable::Sk(s) => serde_json::to_value(s.results()),
+            Observable::BondOrder(b) => serde_json::to_value(b.results()),
         }
         .expect("results serialise")
     }
@@ -173,6 +210,8 @@ impl Observable {
             Observable::Rdf(g) => g.dimension,
             Observable::Msd(m) => m.dimension,
             Observable::Vacf(c) => c.dimension,
+            Observable::Sk(s) => s.dimension,
+            Observable::BondOrder(b) => b.dimension,
         }
     }
 
@@ -184,6 +223,8 @@ impl Observable {
             Observable::Rdf(g) => Some(g.due()),
             Observable::Msd(m) => Some(m.due()),
             Observable::Vacf(c) => Some(c.due()),
+            Observable::Sk(s) => Some(s.due()),
+            Observable::BondOrder(b) => Some(b.due()),
         }
     }
 
@@ -195,6 +236,8 @@ impl Observable {
             Observable::Rdf(g) => g.sample(sim.particles(), sim.sim_box(), t),
             Observable::Msd(m) => m.sample(sim.particles(), t),
             Observable::Vacf(c) => c.sample(sim.particles(), t),
+            Observable::Sk(s) => s.sample(sim.particles(), t),
+            Observable::BondOrder(b) => b.sample(sim.particles(), sim.sim_box(), t),
         }
     }
 
@@ -205,6 +248,11 @@ impl Observable {
             Observable::Rdf(g) => vec![("rdf.csv", g.csv())],
             Observable::Msd(m) => vec![("msd.csv", m.csv())],
             Observable::Vacf(c) => vec![("vacf.csv", c.csv())],
+            Observable::Sk(s) => vec![("sk.csv", s.csv())],
+            Observable::BondOrder(b) if b.dimension == 2 => {
+                vec![("bond_order.csv", b.csv()), ("g6.csv", b.g6_csv())]
+            }
+            Observable::BondOrder(b) => vec![("bond_order.csv", b.csv())],
         }
     }
 }
@@ -217,6 +265,8 @@ impl<const D: usize> Observer<D> for Observable {
             Observable::Rdf(g) => g.observe(sim, outcome),
             Observable::Msd(m) => m.observe(sim, outcome),
             Observable::Vacf(c) => c.observe(sim, outcome),
+            Observable::Sk(s) => s.observe(sim, outcome),
+            Observable::BondOrder(b) => b.observe(sim, outcome),
         }
     }
 }

@@ -12,7 +12,8 @@
 //!
 //! The diffusion coefficient is the slope of the MSD over the last two octaves it holds
 //! well, `D = [M(τ) − M(τ/4)] / (2d·(3τ/4))`, `τ` the longest lag averaged over at least
-//! [`MIN_ORIGINS`] origins: the linear regime's slope, free of the ballistic start's offset
+//! [`MIN_ORIGINS`] origins and no longer than one of the jackknife's time blocks
+//! ([`Correlator::longest_lag`]): the linear regime's slope, free of the ballistic start's offset
 //! (in 2D, where `D(t)` grows like `ln t`, the value at that `τ`). Errors are the
 //! correlator's block jackknife. With the total momentum at zero the centre of mass does not
 //! move, so nothing is subtracted.

@@ -12,7 +12,8 @@
 //!
 //! `D_GK(τ) = (1/d)·⟨v(t₀)·Δr(τ)⟩ → D`,
 //!
-//! read at the longest lag averaged over at least [`MIN_ORIGINS`] origins (in 2D it grows
+//! read at the longest lag averaged over at least [`MIN_ORIGINS`] origins and no longer than
+//! one of the jackknife's time blocks (in 2D it grows
 //! like `ln τ`: the long-time tail). The MSD's `D` is the same limit by another estimator
 //! (`⟨Δr²⟩ = 2d∫₀^τ (τ − s) C(s) ds`). `C(0) = ⟨v²⟩ = d·kT/m`.
 //!

@@ -657,7 +657,11 @@ impl Config {
                 format!("this is a {d}D run: give dimension = {d}"),
             ));
         }
-        self.observe.check().map_err(|(field, value, allowed)| Invalid::value(field, value, allowed))?;
+        let periodic = match &self.sim_box.boundary {
+            Boundaries::All(b) => *b == Boundary::Periodic,
+            Boundaries::PerAxis(v) => v.iter().all(|b| *b == Boundary::Periodic),
+        };
+        self.observe.check(periodic).map_err(|(field, value, allowed)| Invalid::value(field, value, allowed))?;
         let positive = |name: &str, x: f64| {
             if x.is_finite() && x > 0.0 {
                 Ok(())

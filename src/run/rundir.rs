@@ -24,9 +24,20 @@ use std::fs::{self, File, OpenOptions};
 use std::io::{self, Read, Seek, Write};
 use std::path::{Path, PathBuf};
 
-/// The files of a run (the observables' files among them: `rdf.csv`, `msd.csv`, `vacf.csv`).
-pub const RUN_FILES: [&str; 7] =
-    ["summary.json", "timeseries.csv", "trajectory.xyz", "checkpoint.json", "rdf.csv", "msd.csv", "vacf.csv"];
+/// The files of a run (the observables' files among them: `rdf.csv`, `msd.csv`, `vacf.csv`,
+/// `sk.csv`, `bond_order.csv`, `g6.csv`).
+pub const RUN_FILES: [&str; 10] = [
+    "summary.json",
+    "timeseries.csv",
+    "trajectory.xyz",
+    "checkpoint.json",
+    "rdf.csv",
+    "msd.csv",
+    "vacf.csv",
+    "sk.csv",
+    "bond_order.csv",
+    "g6.csv",
+];
 
 /// The lock file.
 pub const LOCK: &str = ".collide.lock";
