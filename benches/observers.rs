@@ -1,9 +1,9 @@
 //! What the observables cost at their default sampling rates: 10⁴ disks at η = 0.3 and 10⁴
 //! spheres at 0.45 (periodic, the benchmark report's starts, warmed up). For each observable,
-//! `observers/<name>` times one of its sampling intervals — the events up to its next due
-//! instant, then its sample there, as a run does — and `observers/engine_<name>` the same
-//! stretch of simulated time without the sample: their ratio less one is the observable's
-//! share of a run's time (the README's figures: `cargo bench --bench observers`).
+//! `observers/<name>` times its sample at each due instant (the events between them run
+//! untimed, as a run runs them) and `observers/engine_<name>` the events of one sampling
+//! interval: the first over the second is the observable's cost against the engine's time at
+//! its default rate (docs/configuration.md's figures: `cargo bench --bench observers`).
 
 use collide::engine::Simulation;
 use collide::observe::{Observable, Selection};
@@ -19,18 +19,20 @@ fn warmed_up<const D: usize>(n: usize, eta: f64) -> Simulation<D> {
     sim
 }
 
-/// `iters` sampling intervals of `observable`: the events up to its next due instant, then
-/// its sample.
-fn intervals<const D: usize>(sim: &mut Simulation<D>, observable: &mut Observable, iters: u64) -> Duration {
-    let start = Instant::now();
+/// `iters` sampling intervals of `observable`: the events up to its next due instant (not
+/// timed), then its sample (timed).
+fn samples<const D: usize>(sim: &mut Simulation<D>, observable: &mut Observable, iters: u64) -> Duration {
+    let mut total = Duration::ZERO;
     for _ in 0..iters {
         let due = observable.due().expect("samples at its own instants");
         while sim.quiet_until() < due {
             sim.step().unwrap();
         }
+        let start = Instant::now();
         observable.sample(sim, due);
+        total += start.elapsed();
     }
-    start.elapsed()
+    total
 }
 
 fn selections() -> Vec<(&'static str, Selection)> {
@@ -46,7 +48,7 @@ fn observers<const D: usize>(c: &mut Criterion, label: &str, eta: f64) {
             continue;
         }
         let mut observable = selection.start(&sim).remove(0);
-        group.bench_function(name, |b| b.iter_custom(|iters| intervals(&mut sim, &mut observable, iters)));
+        group.bench_function(name, |b| b.iter_custom(|iters| samples(&mut sim, &mut observable, iters)));
         let mut observable = selection.start(&sim).remove(0);
         group.bench_function(format!("engine_{name}"), |b| {
             b.iter_custom(|iters| {

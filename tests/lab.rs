@@ -510,8 +510,8 @@ fn jamming_checks_can_fail() {
 
 #[test]
 fn structure_diffusion_and_long_time_tail_quick_pass() {
-    use collide::lab::{diffusion, long_time_tail, structure};
-    for name in [structure::NAME, diffusion::NAME, long_time_tail::NAME] {
+    use collide::lab::{diffusion, hexatic, long_time_tail, structure};
+    for name in [structure::NAME, diffusion::NAME, long_time_tail::NAME, hexatic::NAME] {
         let (result, dir) = quick(name);
         assert!(result.passed(), "{}", collide::lab::check::table(name, &result.checks));
         assert_svgs(&result, dir);
@@ -556,4 +556,21 @@ fn structure_diffusion_and_long_time_tail_checks_can_fail() {
     assert!(!checks(-1.0 + 1.05 * (t * tail.slope_err + 0.1), tail.amplitude)[0]);
     assert!(!checks(-0.2, tail.amplitude)[0] && !checks(-2.0, tail.amplitude)[0]);
     assert!(!checks(tail.slope, 0.5 * tail.amplitude_theory - t * tail.amplitude_err)[1]);
+}
+
+/// The hexatic check fails when the order does not grow across the transition: the same
+/// states with the ends' orders swapped, or equal within their errors.
+#[test]
+fn hexatic_check_can_fail() {
+    use collide::lab::hexatic::{OrderState, checks};
+    let (result, _) = quick("hexatic");
+    let states: Vec<OrderState> = serde_json::from_value(result.data["states"].clone()).unwrap();
+    assert!(checks(2, &states)[0].pass);
+    let mut swapped = states.clone();
+    let last = swapped.len() - 1;
+    (swapped[0].order, swapped[last].order) = (states[last].order, states[0].order);
+    assert!(!checks(2, &swapped)[0].pass);
+    let mut flat = states.clone();
+    flat[last].order = flat[0].order + 2.0 * flat[0].order_err.hypot(flat[last].order_err);
+    assert!(!checks(2, &flat)[0].pass);
 }

@@ -281,12 +281,14 @@ def test_samples_are_the_command_lines_time_series(tmp_path):
 
 
 def test_observables_run_in_the_package_as_in_the_command_line(tmp_path):
-    text = collide.default_config().replace("[run]", "[observe.rdf]\nr_max = 3.0\nbins = 300\n\n[run]")
+    observe = "[observe.rdf]\nr_max = 3.0\nbins = 300\n[observe.msd]\n[observe.vacf]\n[observe.sk]\n[observe.bond_order]\n\n"
+    text = collide.default_config().replace("[run]", observe + "[run]")
     sim = collide.Simulation.from_config(text)
     assert sim.run() == "complete"
-    got = sim.summary()["observables"]["rdf"]
-    expected = cli_summary(text, tmp_path, "rdf")["observables"]["rdf"]
-    assert got == expected
+    everything = sim.summary()["observables"]
+    assert sorted(everything) == ["bond_order", "msd", "rdf", "sk", "vacf"]
+    assert everything == cli_summary(text, tmp_path, "rdf")["observables"]
+    got = everything["rdf"]
     (contact,) = got["contact"]
     assert contact["species"] == [0, 0] and contact["sigma"] == 1.0
     # The pressure route of the same run, within the 3σ-equivalent of both errors.

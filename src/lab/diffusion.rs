@@ -2,7 +2,7 @@
 //! integral of the velocity autocorrelation, against Enskog's — disks or spheres.
 //!
 //! Each state (periodic box, equilibrated from a lattice) runs with the `msd` and `vacf`
-//! observers, sampling every half mean free time. Checks per density:
+//! observers, sampling every mean free time. Checks per density:
 //!
 //! * **two routes to D**: `⟨Δr²(τ)⟩ = 2∫₀^τ ⟨v(0)·Δr(s)⟩ ds` in equilibrium, so the MSD's
 //!   slope over `[τ/4, τ]` (the `msd` observer's D, `τ` its longest well-sampled lag) equals
@@ -97,7 +97,7 @@ pub fn lags_within(c: &Correlator, from: f64, to: f64) -> Vec<usize> {
 pub fn measure(d: usize, eta: f64, n: usize, per_particle: u64, seed: u64) -> Result<DiffusionState, ExperimentError> {
     let production = per_particle * n as u64;
     let (rate, _, _, _) = enskog_reference(d, eta);
-    let every = 0.5 / rate;
+    let every = 1.0 / rate;
     let observe = format!("[observe.msd]\nevery = {every:?}\n[observe.vacf]\nevery = {every:?}\n");
     let config = Config::parse(&fluid_config(d, eta, n, production / 10, production, seed, &observe), NAME)?;
     if d == 3 { measure_in::<3>(config, eta, n, production) } else { measure_in::<2>(config, eta, n, production) }
@@ -204,9 +204,9 @@ pub fn run(options: &Options) -> Result<ExperimentResult, ExperimentError> {
     let d = options.dimension;
     let (n, per_particle, etas) = match (d, options.quick) {
         (2, true) => (900, 600, vec![0.3]),
-        (2, false) => (2500, 2000, vec![0.1, 0.3, 0.5]),
+        (2, false) => (2500, 1500, vec![0.1, 0.3, 0.5]),
         (_, true) => (1000, 600, vec![0.3]),
-        (_, false) => (2744, 1500, vec![0.1, 0.25, 0.4]),
+        (_, false) => (2744, 1000, vec![0.1, 0.25, 0.4]),
     };
     let states = super::in_parallel(etas.len(), 1, |k| measure(d, etas[k], n, per_particle, options.seed + k as u64))?;
     let checks: Vec<Check> = states.iter().flat_map(|s| checks_for(d, s)).collect();
@@ -248,7 +248,7 @@ pub fn run(options: &Options) -> Result<ExperimentResult, ExperimentError> {
     Ok(options.result(
         NAME,
         json!({ "dimension": d, "n_particles": n, "packing_fractions": etas, "boundary": "periodic", "kT": 1.0,
-            "production_collisions_per_particle": per_particle, "sample_every_mean_free_times": 0.5 }),
+            "production_collisions_per_particle": per_particle, "sample_every_mean_free_times": 1.0 }),
         json!({ "states": states }),
         checks,
         vec!["running_d.svg".into(), "d_over_enskog.svg".into()],

@@ -22,6 +22,7 @@ pub mod collision_rate;
 pub mod diffusion;
 pub mod equation_of_state;
 pub mod equipartition;
+pub mod hexatic;
 pub mod jamming;
 pub mod long_time_tail;
 pub mod maxwell_boltzmann;
@@ -54,6 +55,7 @@ pub const EXPERIMENTS: &[(&str, Experiment)] = &[
     (structure::NAME, structure::run),
     (diffusion::NAME, diffusion::run),
     (long_time_tail::NAME, long_time_tail::run),
+    (hexatic::NAME, hexatic::run),
 ];
 
 /// Why an experiment could not finish (its checks failing is not an error: they are in the
