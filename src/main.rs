@@ -114,6 +114,11 @@ struct ValidateArgs {
     /// CI-sized experiments (seconds) instead of report quality (minutes).
     #[arg(long)]
     quick: bool,
+    /// Longer runs than report quality for the experiments that have them (structure,
+    /// diffusion, long_time_tail, hexatic: up to hours on two cores); the others run at
+    /// report size.
+    #[arg(long, conflicts_with = "quick")]
+    long: bool,
     /// Experiments run at once (default: the number of cores); the results do not depend
     /// on it.
     #[arg(long, value_parser = clap::value_parser!(u32).range(1..=1024))]
@@ -128,7 +133,7 @@ struct ValidateArgs {
 
 impl Default for ValidateArgs {
     fn default() -> Self {
-        ValidateArgs { quick: false, jobs: None, seed: 1, out: PathBuf::from("validation") }
+        ValidateArgs { quick: false, long: false, jobs: None, seed: 1, out: PathBuf::from("validation") }
     }
 }
 
@@ -766,8 +771,8 @@ fn sweep(args: SweepArgs) -> Result<ExitCode> {
 }
 
 fn validate(args: ValidateArgs) -> Result<ExitCode> {
-    use collide::lab::{Options, check::table, report::validate};
-    let options = Options { quick: args.quick, seed: args.seed, out: args.out, dimension: 2 };
+    use collide::lab::{Options, Size, check::table, report::validate};
+    let options = Options { size: Size::of(args.quick, args.long), seed: args.seed, out: args.out, dimension: 2 };
     let cores = std::thread::available_parallelism().map_or(1, |n| n.get());
     let jobs = args.jobs.map_or(cores, |j| j as usize);
     let results = validate(&options, jobs, |name| eprintln!("running {name} …"))?;

@@ -62,6 +62,7 @@ fn maxwell_boltzmann_quick_passes_and_writes_its_outputs() {
     for key in ["parameters", "data", "checks", "plots"] {
         assert!(json.get(key).is_some(), "result.json lacks {key}");
     }
+    assert_eq!((json["size"].as_str(), json["quick"].as_bool()), (Some("quick"), Some(true)));
     for c in json["checks"].as_array().unwrap() {
         for key in ["measured", "error", "expected", "tolerance", "why", "pass"] {
             assert!(c.get(key).is_some(), "a check lacks {key}");
@@ -259,9 +260,13 @@ fn validate_writes_the_report() {
     assert!(md.contains("ALL CHECKS PASS") && !md.contains("| FAIL |"));
     // Two at a time, the experiments give what each gives alone, to the bit.
     let (threaded, _) = quick("equipartition");
-    let alone =
-        collide::lab::equipartition::run(&Options { quick: true, seed: 1, out: out("lab-alone"), dimension: 2 })
-            .unwrap();
+    let alone = collide::lab::equipartition::run(&Options {
+        size: collide::lab::Size::Quick,
+        seed: 1,
+        out: out("lab-alone"),
+        dimension: 2,
+    })
+    .unwrap();
     assert_eq!(serde_json::to_string(&threaded).unwrap(), serde_json::to_string(&alone).unwrap());
 }
 
@@ -573,4 +578,21 @@ fn hexatic_check_can_fail() {
     let mut flat = states.clone();
     flat[last].order = flat[0].order + 2.0 * flat[0].order_err.hypot(flat[last].order_err);
     assert!(!checks(2, &flat)[0].pass);
+}
+
+/// `--quick` and `--long` together are refused (exit 2, naming both) before anything runs.
+#[test]
+fn quick_and_long_together_are_refused() {
+    for args in [&["validate", "--quick", "--long"][..], &["experiment", "structure", "--long", "--quick"][..]] {
+        let dir = out("lab-quick-long");
+        let output = std::process::Command::new(env!("CARGO_BIN_EXE_collide"))
+            .args(args)
+            .args(["--out", dir.to_str().unwrap()])
+            .output()
+            .expect("collide starts");
+        let stderr = String::from_utf8_lossy(&output.stderr);
+        assert_eq!(output.status.code(), Some(2), "{args:?}: {stderr}");
+        assert!(stderr.contains("--quick") && stderr.contains("--long"), "{args:?}: {stderr}");
+        assert!(!dir.exists(), "{args:?} wrote {}", dir.display());
+    }
 }

@@ -164,7 +164,7 @@ pub fn checks_for(s: &RateState) -> Vec<Check> {
 pub fn run(options: &Options) -> Result<ExperimentResult, ExperimentError> {
     let d = options.dimension;
     // Spheres on a simple cubic lattice of k³ sites (k = 8, 12).
-    let (n, per_particle, etas) = match (d, options.quick) {
+    let (n, per_particle, etas) = match (d, options.quick()) {
         (2, true) => (400, 200, vec![0.2, 0.5]),
         (2, false) => (1600, 500, vec![0.1, 0.2, 0.3, 0.4, 0.5, 0.6, 0.65]),
         (_, true) => (512, 200, vec![0.2, 0.45]),

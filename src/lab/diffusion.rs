@@ -28,10 +28,10 @@
 use super::collision_rate::{enskog_reference, number_density};
 use super::plot::{Chart, Series, draw};
 use super::stats::three_sigma_factor;
-use super::{Check, ExperimentError, ExperimentResult, Options, fluid_config, run_to_end};
+use super::{Check, ExperimentError, ExperimentResult, Options, Size, finished_run, fluid_config};
 use crate::observe::Observable;
 use crate::observe::correlator::Correlator;
-use crate::run::{Config, Discard, Run};
+use crate::run::Config;
 use crate::theory::{enskog_diffusion, enskog_viscosity, sound_speed};
 use serde::{Deserialize, Serialize};
 use serde_json::json;
@@ -109,14 +109,15 @@ fn measure_in<const D: usize>(
     n: usize,
     collisions: u64,
 ) -> Result<DiffusionState, ExperimentError> {
-    let mut run = Run::<D>::new(config)?;
-    run_to_end(&mut run, &mut Discard)?;
+    let run = finished_run::<D>(config)?;
     let (Some(Observable::Msd(msd)), Some(Observable::Vacf(vacf))) = (run.observables.first(), run.observables.get(1))
     else {
         return Err(ExperimentError::Missing("the msd and vacf observables"));
     };
     let diffusion = msd.diffusion();
-    let Some(dm) = diffusion.first() else { return Err(ExperimentError::Missing("a lag with enough origins")) };
+    let (Some(dm), Some((k, q))) = (diffusion.first(), msd.diffusion_lags()) else {
+        return Err(ExperimentError::Missing("a lag with enough origins"));
+    };
     let c = &vacf.correlator;
     let df = D as f64;
     // The mean of D_GK over [τ/4, τ] by the trapezoid rule.
@@ -129,9 +130,8 @@ fn measure_in<const D: usize>(
         .sum();
     let d_gk_mean = trapezoid / (0.75 * dm.lag * df);
     let d_gk_err = at(*within.last().expect("lags within")).values[0][1].1 / df;
-    // The difference of the two routes, jackknifed over the blocks both share.
-    let k = c.longest_lag(crate::observe::msd::MIN_ORIGINS).expect("the MSD's lag");
-    let q = (0..k).find(|&q| c.tau(q) * 4.0 == c.tau(k)).expect("its quarter");
+    // The difference of the two routes over the MSD's own lags, jackknifed over the blocks
+    // both share (the two correlators sample at the same instants, so their lags coincide).
     let (difference, difference_err) = msd.correlator.estimate_with(c, |m, v| {
         let from_msd = (m(k, 0, 0) - m(q, 0, 0)) / (2.0 * df * 0.75 * c.tau(k));
         let integral: f64 =
@@ -202,11 +202,13 @@ pub fn checks_for(d: usize, s: &DiffusionState) -> Vec<Check> {
 /// Runs the experiment.
 pub fn run(options: &Options) -> Result<ExperimentResult, ExperimentError> {
     let d = options.dimension;
-    let (n, per_particle, etas) = match (d, options.quick) {
-        (2, true) => (900, 600, vec![0.3]),
-        (2, false) => (2500, 1500, vec![0.1, 0.3, 0.5]),
-        (_, true) => (1000, 600, vec![0.3]),
-        (_, false) => (2744, 1000, vec![0.1, 0.25, 0.4]),
+    let (n, per_particle, etas) = match (d, options.size) {
+        (2, Size::Quick) => (900, 600, vec![0.3]),
+        (2, Size::Report) => (2500, 1500, vec![0.1, 0.3, 0.5]),
+        (2, Size::Long) => (10_000, 4000, vec![0.1, 0.2, 0.3, 0.4, 0.5, 0.6]),
+        (_, Size::Quick) => (1000, 600, vec![0.3]),
+        (_, Size::Report) => (2744, 1000, vec![0.1, 0.25, 0.4]),
+        (_, Size::Long) => (8000, 2000, vec![0.1, 0.2, 0.3, 0.4, 0.45]),
     };
     let states = super::in_parallel(etas.len(), 1, |k| measure(d, etas[k], n, per_particle, options.seed + k as u64))?;
     let checks: Vec<Check> = states.iter().flat_map(|s| checks_for(d, s)).collect();

@@ -285,9 +285,9 @@ fn states(d: usize, quick: bool) -> Vec<(Phase, Start, f64, usize)> {
 /// Runs the experiment.
 pub fn run(options: &Options) -> Result<ExperimentResult, ExperimentError> {
     let d = options.dimension;
-    let per_particle: u64 = if options.quick { 200 } else { 1000 };
+    let per_particle: u64 = if options.quick() { 200 } else { 1000 };
     let mut points = Vec::new();
-    for (k, &(phase, start, eta, n)) in states(d, options.quick).iter().enumerate() {
+    for (k, &(phase, start, eta, n)) in states(d, options.quick()).iter().enumerate() {
         // Dense disks melt from the lattice slowly: equilibrate twice as long above η = 0.6; a
         // compressed state relaxes from the compression's excess pressure slower still: four
         // times as long.

@@ -121,7 +121,7 @@ pub fn run(options: &Options) -> Result<ExperimentResult, ExperimentError> {
     // The length is set by the statistics (see the module docs), the size by the budget.
     let d = options.dimension;
     // Spheres on an fcc lattice of 4k³ sites (k = 5, 8).
-    let (n, horizon) = match (d, options.quick) {
+    let (n, horizon) = match (d, options.quick()) {
         (2, true) => (400, 2000.0),
         (2, false) => (2000, 2000.0),
         (_, true) => (500, 2000.0),

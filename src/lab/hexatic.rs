@@ -20,9 +20,9 @@
 
 use super::plot::{Chart, Series, draw};
 use super::stats::three_sigma_factor;
-use super::{Check, ExperimentError, ExperimentResult, Options, run_to_end};
+use super::{Check, ExperimentError, ExperimentResult, Options, Size, finished_run};
 use crate::observe::Observable;
-use crate::run::{Config, Discard, Run};
+use crate::run::Config;
 use serde::{Deserialize, Serialize};
 use serde_json::json;
 
@@ -68,8 +68,7 @@ fn measure<const D: usize>(eta: f64, n: usize, per_particle: u64, seed: u64) -> 
          [equilibration]\ncollisions = {}\n[run]\ncollisions = {production}\n[observe.bond_order]\nevery = 1.0\n",
         production / 2
     );
-    let mut run = Run::<D>::new(Config::parse(&text, NAME)?)?;
-    run_to_end(&mut run, &mut Discard)?;
+    let run = finished_run::<D>(Config::parse(&text, NAME)?)?;
     let summary = run.summary();
     let Some(Observable::BondOrder(order)) = run.observables.first() else {
         return Err(ExperimentError::Missing("the bond_order observable"));
@@ -106,11 +105,13 @@ pub fn checks(d: usize, states: &[OrderState]) -> Vec<Check> {
 /// Runs the experiment.
 pub fn run(options: &Options) -> Result<ExperimentResult, ExperimentError> {
     let d = options.dimension;
-    let (n, per_particle, etas) = match (d, options.quick) {
-        (2, true) => (2500, 300, vec![0.69, 0.71, 0.73]),
-        (2, false) => (10_000, 400, vec![0.69, 0.70, 0.71, 0.72, 0.73]),
-        (_, true) => (1000, 300, vec![0.49, 0.55]),
-        (_, false) => (4000, 600, vec![0.49, 0.55]),
+    let (n, per_particle, etas) = match (d, options.size) {
+        (2, Size::Quick) => (2500, 300, vec![0.69, 0.71, 0.73]),
+        (2, Size::Report) => (10_000, 400, vec![0.69, 0.70, 0.71, 0.72, 0.73]),
+        (2, Size::Long) => (10_000, 20_000, vec![0.69, 0.70, 0.705, 0.71, 0.715, 0.72, 0.73]),
+        (_, Size::Quick) => (1000, 300, vec![0.49, 0.55]),
+        (_, Size::Report) => (4000, 600, vec![0.49, 0.55]),
+        (_, Size::Long) => (4000, 5000, vec![0.49, 0.52, 0.55]),
     };
     let seed = options.seed;
     let states = super::in_parallel(etas.len(), 1, |k| {

@@ -437,7 +437,7 @@ pub fn checks(d: usize, plan: &Plan, packings: &[Packing], crystal: &Packing) ->
 /// Runs the experiment.
 pub fn run(options: &Options) -> Result<ExperimentResult, ExperimentError> {
     let d = options.dimension;
-    let plan = Plan::new(d, options.quick);
+    let plan = Plan::new(d, options.quick());
     let (packings, crystal) =
         if d == 3 { packings::<3>(&plan, options.seed)? } else { packings::<2>(&plan, options.seed)? };
     let checks = checks(d, &plan, &packings, &crystal);

@@ -26,9 +26,9 @@ use super::collision_rate::{enskog_reference, number_density};
 use super::diffusion::{lags_within, slope};
 use super::plot::{Chart, Series, draw};
 use super::stats::three_sigma_factor;
-use super::{Check, ExperimentError, ExperimentResult, Options, fluid_config, run_to_end};
+use super::{Check, ExperimentError, ExperimentResult, Options, Size, finished_run, fluid_config};
 use crate::observe::Observable;
-use crate::run::{Config, Discard, Run};
+use crate::run::Config;
 use crate::theory::{enskog_diffusion, enskog_viscosity, sound_speed, tail_amplitude};
 use serde::{Deserialize, Serialize};
 use serde_json::json;
@@ -95,11 +95,13 @@ pub fn checks(d: usize, tail: &Tail) -> Vec<Check> {
 /// Runs the experiment.
 pub fn run(options: &Options) -> Result<ExperimentResult, ExperimentError> {
     let d = options.dimension;
-    let (n, per_particle) = match (d, options.quick) {
-        (2, true) => (2500, 1000),
-        (2, false) => (10_000, 2000),
-        (_, true) => (2744, 600),
-        (_, false) => (13_824, 800),
+    let (n, per_particle) = match (d, options.size) {
+        (2, Size::Quick) => (2500, 1000),
+        (2, Size::Report) => (10_000, 2000),
+        (2, Size::Long) => (40_000, 4000),
+        (_, Size::Quick) => (2744, 600),
+        (_, Size::Report) => (13_824, 800),
+        (_, Size::Long) => (32_768, 2000),
     };
     let tail = if d == 3 {
         measure::<3>(n, per_particle, options.seed)?
@@ -155,8 +157,7 @@ fn measure<const D: usize>(n: usize, per_particle: u64, seed: u64) -> Result<Tai
     let every = 1.0 / rate;
     let observe = format!("[observe.vacf]\nevery = {every:?}\nmax_lag = {:?}\n", 2.0 * crossing);
     let config = Config::parse(&fluid_config(D, ETA, n, production / 10, production, seed, &observe), NAME)?;
-    let mut run = Run::<D>::new(config)?;
-    run_to_end(&mut run, &mut Discard)?;
+    let run = finished_run::<D>(config)?;
     let Some(Observable::Vacf(vacf)) = run.observables.first() else {
         return Err(ExperimentError::Missing("the vacf observable"));
     };

@@ -96,7 +96,7 @@ pub fn run(options: &Options) -> Result<ExperimentResult, ExperimentError> {
 
 fn run_in<const D: usize>(options: &Options) -> Result<ExperimentResult, ExperimentError> {
     // Spheres on a perfect fcc lattice of 4k³ sites (k = 10, 20).
-    let (n, horizon) = match (D, options.quick) {
+    let (n, horizon) = match (D, options.quick()) {
         (2, true) => (2000, 20.0),
         (2, false) => (20000, 30.0),
         (_, true) => (4000, 20.0),

@@ -135,6 +135,14 @@ pub fn run_to_end<const D: usize, S: crate::run::Sink<D, Error = std::convert::I
     Ok(())
 }
 
+/// A run of `config` taken to its end without output: the experiments' way of measuring a
+/// state through the observers it configures (`run.observables`, in `[observe]`'s order).
+pub fn finished_run<const D: usize>(config: crate::run::Config) -> Result<crate::run::Run<D>, ExperimentError> {
+    let mut run = crate::run::Run::<D>::new(config)?;
+    run_to_end(&mut run, &mut crate::run::Discard)?;
+    Ok(run)
+}
+
 /// The configuration of a fluid of `n` unit-diameter particles of unit mass at packing
 /// fraction `eta` in a periodic box (`d` = 2: from the triangular lattice; 3: from the simple
 /// cubic one, which melts at once), `equilibration` collisions then `production`, followed
@@ -156,11 +164,47 @@ pub fn fluid_config(
     )
 }
 
+/// How long an experiment runs.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum Size {
+    /// CI-sized (seconds): the checks still bite, with wider statistical tolerances.
+    Quick,
+    /// Report quality (minutes): what `collide validate` runs and the manual quotes.
+    #[default]
+    Report,
+    /// Longer runs (up to an hour or more on two cores) for the experiments that have them
+    /// (`structure`, `diffusion`, `long_time_tail`, `hexatic`); the others run at report size.
+    Long,
+}
+
+impl Size {
+    /// The size the flags `--quick` and `--long` ask for (clap refuses both at once).
+    pub fn of(quick: bool, long: bool) -> Size {
+        if quick {
+            Size::Quick
+        } else if long {
+            Size::Long
+        } else {
+            Size::Report
+        }
+    }
+
+    /// `"quick"`, `"report size"` or `"long"`.
+    pub fn label(self) -> &'static str {
+        match self {
+            Size::Quick => "quick",
+            Size::Report => "report size",
+            Size::Long => "long",
+        }
+    }
+}
+
 /// How to run an experiment.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Options {
-    /// CI-sized run (seconds) instead of report quality (minutes).
-    pub quick: bool,
+    /// How long.
+    pub size: Size,
     /// Seed of the initial states.
     pub seed: u64,
     /// Where `<name>/result.json` (`<name>_3d/` in 3D) and the plots go.
@@ -172,7 +216,12 @@ pub struct Options {
 impl Options {
     /// Disks, report size, seed 1, into `out`.
     pub fn new(out: impl Into<PathBuf>) -> Options {
-        Options { quick: false, seed: 1, out: out.into(), dimension: 2 }
+        Options { size: Size::Report, seed: 1, out: out.into(), dimension: 2 }
+    }
+
+    /// Whether this is the CI-sized version.
+    pub fn quick(&self) -> bool {
+        self.size == Size::Quick
     }
 
     /// The directory name of experiment `name` in this dimension: `name` for disks,
@@ -198,7 +247,8 @@ impl Options {
         ExperimentResult {
             name: name.into(),
             dimension: self.dimension,
-            quick: self.quick,
+            quick: self.quick(),
+            size: self.size,
             seed: self.seed,
             parameters,
             data,
@@ -223,6 +273,9 @@ pub struct ExperimentResult {
     pub dimension: usize,
     /// Whether this was the quick version.
     pub quick: bool,
+    /// Its size (`quick`, `report` or `long`).
+    #[serde(default)]
+    pub size: Size,
     /// The seed.
     pub seed: u64,
     /// The parameters used.
@@ -309,6 +362,10 @@ pub struct ExperimentArgs {
     /// CI-sized run (seconds) instead of report quality.
     #[arg(long)]
     pub quick: bool,
+    /// Longer runs than report quality, for the experiments that have them (structure,
+    /// diffusion, long_time_tail, hexatic); the others run at report size.
+    #[arg(long, conflicts_with = "quick")]
+    pub long: bool,
     /// Seed of the initial states.
     #[arg(long, default_value_t = 1)]
     pub seed: u64,
@@ -322,7 +379,12 @@ pub struct ExperimentArgs {
 
 impl From<ExperimentArgs> for Options {
     fn from(args: ExperimentArgs) -> Options {
-        Options { quick: args.quick, seed: args.seed, out: args.out, dimension: args.dimension as usize }
+        Options {
+            size: Size::of(args.quick, args.long),
+            seed: args.seed,
+            out: args.out,
+            dimension: args.dimension as usize,
+        }
     }
 }
 

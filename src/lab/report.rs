@@ -12,7 +12,8 @@ pub fn numerics(options: &Options) -> ExperimentResult {
     ExperimentResult {
         name: "numerics".into(),
         dimension: 2,
-        quick: options.quick,
+        quick: options.quick(),
+        size: options.size,
         seed: options.seed,
         parameters: serde_json::json!({ "cases": report.cases }),
         data: serde_json::json!({ "report": report.text }),
@@ -56,7 +57,7 @@ pub fn write_report(results: &[ExperimentResult], options: &Options) -> Result<(
     let header = format!(
         "collide {} · {} · seed {} · {} · {}",
         env!("CARGO_PKG_VERSION"),
-        if options.quick { "quick" } else { "report size" },
+        options.size.label(),
         options.seed,
         machine(),
         if passed { "ALL CHECKS PASS" } else { "SOME CHECKS FAIL" }

@@ -326,7 +326,7 @@ pub fn run(options: &Options) -> Result<ExperimentResult, ExperimentError> {
     let d = options.dimension;
     // Spheres start from a simple cubic lattice of k³ sites (k = 14, 16): a box with a bulk
     // region 5σ from every wall.
-    let (n, per_particle, etas, t_one, identity_at) = match (d, options.quick) {
+    let (n, per_particle, etas, t_one, identity_at) = match (d, options.quick()) {
         (2, true) => (400, 200, vec![0.2, 0.4], 2.0e4, 0.4),
         (2, false) => (1600, 500, vec![0.1, 0.2, 0.3, 0.4, 0.5, 0.6], 2.0e5, 0.4),
         (_, true) => (2744, 100, vec![0.1, 0.3], 2.0e4, 0.3),

@@ -70,31 +70,19 @@ pub struct Options {
 
 impl Options {
     /// Checks the options (`[observe.bond_order]`): the key, its value and what is allowed.
-    pub fn check(&self) -> Result<(), (String, String, String)> {
-        let bad = |key: &str, value: String, allowed: &str| {
-            Err((format!("observe.bond_order.{key}"), value, allowed.to_string()))
-        };
+    pub fn check(&self) -> Result<(), super::Refusal> {
         if let Some(c) = self.cutoff
             && !(c.is_finite() && (1.0..=3.0).contains(&c))
         {
-            return bad("cutoff", c.to_string(), "must lie in [1, 3] contact distances");
+            return Err((
+                "observe.bond_order.cutoff".into(),
+                c.to_string(),
+                "must lie in [1, 3] contact distances".into(),
+            ));
         }
-        if let Some(r) = self.r_max
-            && !(r.is_finite() && r > 0.0)
-        {
-            return bad("r_max", r.to_string(), "must be a positive length");
-        }
-        if let Some(b) = self.bins
-            && !(1..=1_000_000).contains(&b)
-        {
-            return bad("bins", b.to_string(), "must lie in 1 ..= 1000000");
-        }
-        if let Some(e) = self.every
-            && !(e.is_finite() && e > 0.0)
-        {
-            return bad("every", e.to_string(), "must be a positive time");
-        }
-        Ok(())
+        super::positive("bond_order", "r_max", self.r_max, "length")?;
+        super::count_within("bond_order", "bins", self.bins, 1_000_000)?;
+        super::positive("bond_order", "every", self.every, "time")
     }
 }
 
@@ -359,15 +347,7 @@ mod tests {
                 .map(|k| {
                     let (i, j) = (k % cols, k / cols);
                     let shift = if triangular && j % 2 == 1 { 0.5 } else { 0.0 };
-                    Particle {
-                        position: SVector::from([i as f64 + shift + 0.1, j as f64 * dy + 0.1]),
-                        velocity: SVector::zeros(),
-                        time: 0.0,
-                        radius: 0.5,
-                        mass: 1.0,
-                        species: 0,
-                        events: 0,
-                    }
+                    super::super::test_particle([i as f64 + shift + 0.1, j as f64 * dy + 0.1], [0.0; 2])
                 })
                 .collect();
             let lengths = SVector::from([cols as f64, rows as f64 * dy]);

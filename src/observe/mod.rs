@@ -50,6 +50,45 @@ pub use thermo::{Sample, Thermo, Totals};
 use crate::engine::{Outcome, Simulation};
 use serde::{Deserialize, Serialize};
 
+/// A unit-diameter, unit-mass particle of species 0 at `position` moving at `velocity` from
+/// time 0: the observers' tests build their configurations from it.
+#[cfg(test)]
+pub(crate) fn test_particle<const D: usize>(position: [f64; D], velocity: [f64; D]) -> crate::engine::Particle<D> {
+    crate::engine::Particle {
+        position: position.into(),
+        velocity: velocity.into(),
+        time: 0.0,
+        radius: 0.5,
+        mass: 1.0,
+        species: 0,
+        events: 0,
+    }
+}
+
+/// An option refused: its key (`observe.<observer>.<field>`), its value, and what is allowed.
+pub type Refusal = (String, String, String);
+
+/// Refuses `value` of `observe.<observer>.<key>` unless it is a positive finite number;
+/// `what` names the quantity ("length", "time", "wave number").
+fn positive(observer: &str, key: &str, value: Option<f64>, what: &str) -> Result<(), Refusal> {
+    match value {
+        Some(x) if !(x.is_finite() && x > 0.0) => {
+            Err((format!("observe.{observer}.{key}"), x.to_string(), format!("must be a positive {what}")))
+        }
+        _ => Ok(()),
+    }
+}
+
+/// Refuses a count `value` of `observe.<observer>.<key>` outside `1 ..= max`.
+fn count_within(observer: &str, key: &str, value: Option<usize>, max: usize) -> Result<(), Refusal> {
+    match value {
+        Some(n) if !(1..=max).contains(&n) => {
+            Err((format!("observe.{observer}.{key}"), n.to_string(), format!("must lie in 1 ..= {max}")))
+        }
+        _ => Ok(()),
+    }
+}
+
 /// Anything that wants to see every event.
 pub trait Observer<const D: usize> {
     /// Called after every processed event, with the simulation as the event left it.
@@ -90,7 +129,7 @@ impl Selection {
 
     /// Checks the options for a box `periodic` along every axis or not: the key, its value
     /// and what is allowed.
-    pub fn check(&self, periodic: bool) -> Result<(), (String, String, String)> {
+    pub fn check(&self, periodic: bool) -> Result<(), Refusal> {
         if let Some(options) = &self.rdf {
             options.check()?;
         }

@@ -49,14 +49,9 @@ pub const MIN_ORIGINS: u64 = 64;
 
 impl Options {
     /// Checks the options of `[observe.<name>]`: the key, its value and what is allowed.
-    pub fn check(&self, name: &str) -> Result<(), (String, String, String)> {
-        for (key, value) in [("every", self.every), ("max_lag", self.max_lag)] {
-            if let Some(x) = value
-                && !(x.is_finite() && x > 0.0)
-            {
-                return Err((format!("observe.{name}.{key}"), x.to_string(), "must be a positive time".into()));
-            }
-        }
+    pub fn check(&self, name: &str) -> Result<(), super::Refusal> {
+        super::positive(name, "every", self.every, "time")?;
+        super::positive(name, "max_lag", self.max_lag, "time")?;
         if let (Some(every), Some(max_lag)) = (self.every, self.max_lag)
             && max_lag < every
         {
@@ -139,17 +134,19 @@ impl Msd {
         self.next = t + self.correlator.every;
     }
 
+    /// The lags `(k, q)` (indices) that `D` is read between: `τ_k` the longest lag with
+    /// enough origins whose quarter `τ_q = τ_k/4` is a lag too (None before there is one).
+    pub fn diffusion_lags(&self) -> Option<(usize, usize)> {
+        let c = &self.correlator;
+        let longest = c.longest_lag(MIN_ORIGINS)?;
+        (0..=longest).rev().find_map(|k| (0..k).find(|&q| c.tau(q) * 4.0 == c.tau(k)).map(|q| (k, q)))
+    }
+
     /// Per species, `D` from the slope over the last two octaves (see the module docs).
     pub fn diffusion(&self) -> Vec<Diffusion> {
         let c = &self.correlator;
         let d = self.dimension as f64;
-        // The longest lag with enough origins whose quarter is a lag too.
-        let Some(longest) = c.longest_lag(MIN_ORIGINS) else { return Vec::new() };
-        let Some((k, q)) =
-            (0..=longest).rev().find_map(|k| (0..k).find(|&q| c.tau(q) * 4.0 == c.tau(k)).map(|q| (k, q)))
-        else {
-            return Vec::new();
-        };
+        let Some((k, q)) = self.diffusion_lags() else { return Vec::new() };
         let tau = c.tau(k);
         (0..c.counts.len())
             .filter(|&s| c.counts[s] > 0)
@@ -204,17 +201,8 @@ mod tests {
     /// ballistic MSD is the slope's 5/4·⟨v²⟩τ/(2d) — the estimator is what its docs say.
     #[test]
     fn free_flight_is_ballistic() {
-        let particles: Vec<Particle<2>> = (0..4)
-            .map(|i| Particle {
-                position: SVector::from([i as f64, 0.0]),
-                velocity: SVector::from([1.0 + i as f64, 0.5]),
-                time: 0.0,
-                radius: 0.5,
-                mass: 1.0,
-                species: 0,
-                events: 0,
-            })
-            .collect();
+        let particles: Vec<Particle<2>> =
+            (0..4).map(|i| super::super::test_particle([i as f64, 0.0], [1.0 + i as f64, 0.5])).collect();
         let v2 = particles.iter().map(|p| p.velocity.norm_squared()).sum::<f64>() / 4.0;
         let mut msd = Msd::of(
             &particles,

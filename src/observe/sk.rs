@@ -70,9 +70,7 @@ const BLOCKS: usize = 20;
 
 impl Options {
     /// Checks the options (`[observe.sk]`) for a box `periodic` along every axis or not.
-    pub fn check(&self, periodic: bool) -> Result<(), (String, String, String)> {
-        let bad =
-            |key: &str, value: String, allowed: &str| Err((format!("observe.sk.{key}"), value, allowed.to_string()));
+    pub fn check(&self, periodic: bool) -> Result<(), super::Refusal> {
         if !periodic {
             return Err((
                 "observe.sk".into(),
@@ -81,27 +79,10 @@ impl Options {
                     .into(),
             ));
         }
-        if let Some(k) = self.k_max
-            && !(k.is_finite() && k > 0.0)
-        {
-            return bad("k_max", k.to_string(), "must be a positive wave number");
-        }
-        if let Some(b) = self.bins
-            && !(1..=100_000).contains(&b)
-        {
-            return bad("bins", b.to_string(), "must lie in 1 ..= 100000");
-        }
-        if let Some(v) = self.vectors
-            && !(1..=100_000).contains(&v)
-        {
-            return bad("vectors", v.to_string(), "must lie in 1 ..= 100000");
-        }
-        if let Some(e) = self.every
-            && !(e.is_finite() && e > 0.0)
-        {
-            return bad("every", e.to_string(), "must be a positive time");
-        }
-        Ok(())
+        super::positive("sk", "k_max", self.k_max, "wave number")?;
+        super::count_within("sk", "bins", self.bins, 100_000)?;
+        super::count_within("sk", "vectors", self.vectors, 100_000)?;
+        super::positive("sk", "every", self.every, "time")
     }
 }
 
@@ -387,15 +368,7 @@ mod tests {
         fn points<const D: usize>(seed: u64, n: usize, l: f64) -> Vec<Particle<D>> {
             let mut rng = rand::rngs::StdRng::seed_from_u64(seed);
             (0..n)
-                .map(|_| Particle {
-                    position: SVector::from(std::array::from_fn(|_| rng.random::<f64>() * l)),
-                    velocity: SVector::zeros(),
-                    time: 0.0,
-                    radius: 0.5,
-                    mass: 1.0,
-                    species: 0,
-                    events: 0,
-                })
+                .map(|_| super::super::test_particle(std::array::from_fn(|_| rng.random::<f64>() * l), [0.0; D]))
                 .collect()
         }
         fn check<const D: usize>(l: f64) {
