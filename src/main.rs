@@ -775,7 +775,7 @@ fn validate(args: ValidateArgs) -> Result<ExitCode> {
     let options = Options { size: Size::of(args.quick, args.long), seed: args.seed, out: args.out, dimension: 2 };
     let cores = std::thread::available_parallelism().map_or(1, |n| n.get());
     let jobs = args.jobs.map_or(cores, |j| j as usize);
-    let results = validate(&options, jobs, |name| eprintln!("running {name} …"))?;
+    let results = validate(&options, jobs, |line| eprintln!("{line}"))?;
     for r in &results {
         say!("{}", table(&r.slug(), &r.checks).trim_end());
     }

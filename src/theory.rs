@@ -150,6 +150,32 @@ pub fn contact_value(d: usize, eta: f64) -> f64 {
     if d == 2 { g_henderson(eta) } else { g_carnahan_starling(eta) }
 }
 
+/// `g(r)` of hard disks (`d` = 2) or spheres (3) of unit diameter at number density `n` to
+/// first order in the density, exact as `n → 0`: `g(r) = 1 + n·X(r)` for `r ≥ 1`, `X(r)` the
+/// area (volume) common to two disks (spheres) of radius 1 whose centres are `r` apart —
+/// `2·acos(r/2) − (r/2)·√(4 − r²)` in 2D, `(π/12)(4 + r)(2 − r)²` in 3D, 0 beyond `r = 2` —
+/// the Mayer term `∫f(r₁₃)f(r₂₃)dr₃` (Nijboer & van Hove, Phys. Rev. 85, 777 (1952), who
+/// also give the next, O(n²), term for spheres). At contact it is `1 + (b₃/2^(d−1))·η`.
+pub fn g_first_order(d: usize, n: f64, r: f64) -> f64 {
+    if r >= 2.0 {
+        return 1.0;
+    }
+    let overlap = if d == 2 {
+        2.0 * (0.5 * r).acos() - 0.5 * r * (4.0 - r * r).sqrt()
+    } else {
+        PI / 12.0 * (4.0 + r) * (2.0 - r).powi(2)
+    };
+    1.0 + n * overlap
+}
+
+/// The coefficient `c₂` of η² in the contact value's density expansion `g(σ⁺) = 1 + c₁η +
+/// c₂η² + …`, `b₄/2^(d−1)` of the virial series (exact: disks `b₄` = 4.257854, [`VIRIAL_B_2D`];
+/// spheres `b₄` = 18.3648, from `B₄/B₂³ = 0.2869495`): the size of the term
+/// [`g_first_order`] leaves out, at contact.
+pub fn contact_second_order(d: usize) -> f64 {
+    if d == 2 { VIRIAL_B_2D[2] / 2.0 } else { 18.3648 / 4.0 }
+}
+
 /// Enskog's collision frequency per particle, `Γ = 2nσ·g·√(πkT/m)` in 2D and
 /// `Γ = 4nσ²·g·√(πkT/m)` in 3D (Chapman & Cowling, *The Mathematical Theory of Non-uniform
 /// Gases*, 3rd ed. (1970), §16.5; the physics reference sheet), at number density `n`,
@@ -293,5 +319,25 @@ mod tests {
         for eta in [0.545, 0.56, 0.6, 0.65, 0.7, 0.72] {
             assert!((refit(eta) / z_speedy_fcc(eta) - 1.0).abs() < Z_SPEEDY_FCC_ACCURACY, "η = {eta}");
         }
+    }
+
+    /// The first-order `g(r)` at contact is the virial series' `1 + (b₃/2^(d−1))η` (b₃ = 3.128018
+    /// for disks, 10 for spheres); it falls to 1 continuously at `r = 2`; the overlap at
+    /// `r = √2` (2D: a quarter of each disk less a triangle, `π/2 − 1`) and `r = 1` in 3D
+    /// (`5π/12`) by hand.
+    #[test]
+    fn the_first_order_pair_distribution_matches_the_virial_series_and_geometry() {
+        let n2 = |eta: f64| 4.0 * eta / PI;
+        let n3 = |eta: f64| 6.0 * eta / PI;
+        let eta = 0.01;
+        assert!(((g_first_order(2, n2(eta), 1.0) - 1.0) / eta - VIRIAL_B_2D[1] / 2.0).abs() < 1e-6);
+        assert!(((g_first_order(3, n3(eta), 1.0) - 1.0) / eta - 2.5).abs() < 1e-12);
+        assert!((g_first_order(2, 1.0, 2f64.sqrt()) - 1.0 - (PI / 2.0 - 1.0)).abs() < 1e-14);
+        assert!((g_first_order(3, 1.0, 1.0) - 1.0 - 5.0 * PI / 12.0).abs() < 1e-14);
+        for d in [2, 3] {
+            assert!(g_first_order(d, 1.0, 2.0 - 1e-9) - 1.0 < 1e-12);
+            assert_eq!(g_first_order(d, 1.0, 2.5), 1.0);
+        }
+        assert!((contact_second_order(2) - 2.128927).abs() < 1e-6 && (contact_second_order(3) - 4.5912).abs() < 1e-12);
     }
 }

@@ -540,6 +540,21 @@ fn structure_diffusion_and_long_time_tail_checks_can_fail() {
         let s0 = StructureState { s0: s.s0 - 6.0 * s.s0_err - 0.01 * s.s0_reference, ..s.clone() };
         assert!(!structure_checks(&s0)[2].pass, "η = {}", s.eta);
     }
+    // The dilute first shell passes, and fails with its excess over 1 doubled or gone (an
+    // ideal gas's g, or a pair count normalised twice over).
+    for slug in ["structure", "structure_3d"] {
+        use collide::lab::structure::{DiluteState, dilute_check};
+        let (result, _) = quick(slug);
+        let dilute: DiluteState = serde_json::from_value(result.data["dilute"].clone()).unwrap();
+        assert!(dilute_check(&dilute).pass, "{slug}: {}", dilute.worst());
+        for excess in [2.0, 0.0] {
+            let mut wrong = dilute.clone();
+            for b in &mut wrong.bins {
+                b.g += (excess - 1.0) * (b.first_order - 1.0);
+            }
+            assert!(!dilute_check(&wrong).pass, "{slug}: excess ×{excess}: {}", wrong.worst());
+        }
+    }
     let (result, _) = quick("diffusion");
     for state in result.data["states"].as_array().unwrap() {
         let s: DiffusionState = serde_json::from_value(state.clone()).unwrap();

@@ -139,11 +139,16 @@ pub fn write_report(results: &[ExperimentResult], options: &Options) -> Result<(
     Ok(())
 }
 
+/// The experiments that take longest at report size (two minutes or more each on two cores),
+/// which [`validate`] starts first.
+const LONGEST: [&str; 3] = ["jamming", "equation_of_state", "structure"];
+
 /// Runs the numerics check and every experiment in both dimensions (disks, then spheres),
 /// `jobs` experiments at a time (each is single-threaded but `jamming`, and independent of
 /// the others: the results are the same for any `jobs`, in the same order), writes their
-/// results and the report, and returns the results (`progress` hears each experiment's
-/// directory name as it starts). The first error, in that order, is returned once every
+/// results and the report, and returns the results (`progress` hears a line as each
+/// experiment starts, `running <slug> …`, and as it ends, `<slug>: passed in <s> s` — wall
+/// time, which no result holds). The first error, in that order, is returned once every
 /// experiment has ended.
 pub fn validate(
     options: &Options,
@@ -158,15 +163,29 @@ pub fn validate(
                 .map(move |&(name, experiment)| (Options { dimension, ..options.clone() }, name, experiment))
         })
         .collect();
+    // The longest experiments start first, so that no worker is left with one of them at the
+    // end while the others idle (at report size on two cores, started in list order, the
+    // last minute and a half ran one experiment alone). The results keep the list's order.
+    let mut order: Vec<usize> = (0..work.len()).collect();
+    order.sort_by_key(|&k| !LONGEST.contains(&work[k].1));
     let done = super::in_parallel(work.len(), jobs, |k| {
-        let (options, name, experiment) = &work[k];
-        progress(&options.slug(name));
+        let (options, name, experiment) = &work[order[k]];
+        let slug = options.slug(name);
+        progress(&format!("running {slug} …"));
+        let start = std::time::Instant::now();
         let result = experiment(options)?;
         result.write(&options.out)?;
+        progress(&format!(
+            "{slug}: {} in {:.0} s",
+            if result.passed() { "passed" } else { "FAILED" },
+            start.elapsed().as_secs_f64()
+        ));
         Ok(result)
     })?;
     let mut results = vec![numerics(options)];
-    results.extend(done);
+    let mut done: Vec<(usize, ExperimentResult)> = order.into_iter().zip(done).collect();
+    done.sort_by_key(|(k, _)| *k);
+    results.extend(done.into_iter().map(|(_, r)| r));
     write_report(&results, options)?;
     Ok(results)
 }

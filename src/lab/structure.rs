@@ -19,6 +19,16 @@
 //!   tolerance 3.45σ + the reference's accuracy ×10 for its derivative + S(0)/N finite size
 //!   (the canonical ensemble's O(1/N) shift, Lebowitz & Percus, Phys. Rev. 122, 1675 (1961)).
 //!
+//! * **g(r) of a dilute fluid against its exact density expansion**: at η = 0.05, over the
+//!   first shell `[σ, 2σ]` in ten bins of 0.1σ, `g(r) = 1 + n·X(r)` (`X` the overlap of two
+//!   exclusion disks or spheres, [`crate::theory::g_first_order`]; Nijboer & van Hove, Phys.
+//!   Rev. 85, 777 (1952)). Each bin within 3.64 of its Poisson error (the two-sided 3σ
+//!   level's 0.27 % shared by the ten bins; samples every
+//!   ideal-gas collision time, by when a pair within 2σ has parted: independent counts)
+//!   + the omitted O(η²) term at its contact size `c₂η²` (0.5 % of g for disks, 1.1 % for
+//!   spheres; [`crate::theory::contact_second_order`]) + g/N. The check reports the largest
+//!   `|g − g₁|/tolerance` over the ten bins, at most 1.
+//!
 //! Plots: g(r) and S(k) at each density; the contact values and S(0) against η with the
 //! reference curves.
 
@@ -69,6 +79,123 @@ pub struct StructureState {
     pub rdf: Vec<[f64; 2]>,
     /// S(k): bin wave numbers and values.
     pub sk: Vec<[f64; 2]>,
+}
+
+/// One bin of the dilute fluid's first shell.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct ShellBin {
+    /// Its inner and outer radius.
+    pub r: [f64; 2],
+    /// g over the bin (pairs counted over the ideal gas's).
+    pub g: f64,
+    /// Its Poisson error.
+    pub error: f64,
+    /// The first-order g over the bin (weighted as the ideal gas's pairs are).
+    pub first_order: f64,
+    /// The tolerance: 3.64 errors + c₂η² + g/N.
+    pub tolerance: f64,
+}
+
+/// The dilute state whose first shell is compared with the density expansion.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct DiluteState {
+    /// Packing fraction.
+    pub eta: f64,
+    /// Particles.
+    pub n_particles: usize,
+    /// Production collisions.
+    pub collisions: u64,
+    /// Samples of g(r).
+    pub samples: u64,
+    /// The ten bins of `[σ, 2σ]`.
+    pub bins: Vec<ShellBin>,
+}
+
+impl DiluteState {
+    /// The largest `|g − g₁|/tolerance` of the bins.
+    pub fn worst(&self) -> f64 {
+        self.bins.iter().map(|b| (b.g - b.first_order).abs() / b.tolerance).fold(0.0, f64::max)
+    }
+}
+
+/// The dilute fluid's packing fraction.
+pub const DILUTE_ETA: f64 = 0.05;
+
+/// Measures the dilute state: `n` particles at [`DILUTE_ETA`], `per_particle` collisions each
+/// of production (after a tenth as many of equilibration: a dilute gas forgets its lattice in a few collisions), `g(r)` to `2.5σ` in bins of `0.01σ`
+/// sampled every ideal-gas collision time (a pair within 2σ has parted by the next sample:
+/// a particle flies a mean free path, 2.4σ for spheres and 5.5σ for disks at this density).
+pub fn measure_dilute(d: usize, n: usize, per_particle: u64, seed: u64) -> Result<DiluteState, ExperimentError> {
+    let eta = DILUTE_ETA;
+    let production = per_particle * n as u64;
+    let density = crate::lab::collision_rate::number_density(d, eta);
+    let every = 1.0 / crate::theory::enskog_rate(d, density, 1.0, 1.0, 1.0, 1.0);
+    let observe = format!("[observe.rdf]\nevery = {every:?}\nr_max = 2.5\nbins = 250\n");
+    let config = Config::parse(&fluid_config(d, eta, n, production / 10, production, seed, &observe), NAME)?;
+    let rdf = if d == 3 { dilute_rdf::<3>(config)? } else { dilute_rdf::<2>(config)? };
+    Ok(dilute_state(d, eta, n, production, &rdf))
+}
+
+fn dilute_rdf<const D: usize>(config: Config) -> Result<crate::observe::rdf::Rdf, ExperimentError> {
+    let run = finished_run::<D>(config)?;
+    match run.observables.into_iter().next() {
+        Some(Observable::Rdf(rdf)) => Ok(rdf),
+        _ => Err(ExperimentError::Missing("the rdf observable")),
+    }
+}
+
+/// The dilute state's first shell from `rdf` (bins of 0.01σ from 0).
+pub fn dilute_state(d: usize, eta: f64, n: usize, collisions: u64, rdf: &crate::observe::rdf::Rdf) -> DiluteState {
+    let dr = rdf.r_max / rdf.bins as f64;
+    let per = (0.1 / dr).round() as usize;
+    let start = (1.0 / dr).round() as usize;
+    let density = crate::lab::collision_rate::number_density(d, eta);
+    let ideal = rdf.ideal(0);
+    let m = rdf.samples as f64;
+    let t = bin_factor();
+    let omitted = crate::theory::contact_second_order(d) * eta * eta;
+    let bins = (0..10)
+        .map(|j| {
+            let fine = start + j * per..start + (j + 1) * per;
+            let counts: u64 = rdf.counts[0][fine.clone()].iter().sum();
+            let expected: f64 = ideal[fine.clone()].iter().sum::<f64>() * m;
+            let first_order = fine
+                .clone()
+                .map(|k| ideal[k] * crate::theory::g_first_order(d, density, (k as f64 + 0.5) * dr))
+                .sum::<f64>()
+                / ideal[fine.clone()].iter().sum::<f64>();
+            let (g, error) = (counts as f64 / expected, (counts as f64).sqrt() / expected);
+            ShellBin {
+                r: [fine.start as f64 * dr, fine.end as f64 * dr],
+                g,
+                error,
+                first_order,
+                tolerance: t * error + omitted + first_order / n as f64,
+            }
+        })
+        .collect();
+    DiluteState { eta, n_particles: n, collisions, samples: rdf.samples, bins }
+}
+
+/// The per-bin multiple of the Poisson error: the two-sided 3σ level's 0.27 % shared among
+/// the ten bins (Bonferroni), 3.64.
+pub fn bin_factor() -> f64 {
+    use statrs::distribution::{ContinuousCDF, Normal};
+    Normal::standard().inverse_cdf(1.0 - 0.0027 / 20.0)
+}
+
+/// The dilute state's check.
+pub fn dilute_check(s: &DiluteState) -> Check {
+    Check::at_most(
+        &format!(
+            "η = {}: g(r) over [σ, 2σ] vs its exact first order in density (largest |Δg|/tolerance of 10 bins)",
+            s.eta
+        ),
+        s.worst(),
+        f64::NAN,
+        1.0,
+        "g = 1 + n·X(r) (Nijboer & van Hove 1952); per bin 3.64 Poisson errors (the 3σ level shared by 10 bins) + the omitted O(η²) term at its contact size c₂η² + g/N finite size",
+    )
 }
 
 /// `S(0) = 1/(d(ηZ)/dη)` of the reference equation of state of the dimension.
@@ -180,8 +307,18 @@ pub fn run(options: &Options) -> Result<ExperimentResult, ExperimentError> {
         (_, Size::Report) => (3375, 300, vec![0.2, 0.35, 0.45]),
         (_, Size::Long) => (10_648, 2000, vec![0.1, 0.2, 0.3, 0.35, 0.4, 0.45, 0.49]),
     };
+    let (dilute_n, dilute_per_particle) = match (d, options.size) {
+        (2, Size::Quick) => (900, 500),
+        (2, Size::Report) => (3600, 700),
+        (2, Size::Long) => (10_000, 4000),
+        (_, Size::Quick) => (1000, 500),
+        (_, Size::Report) => (3375, 700),
+        (_, Size::Long) => (10_648, 4000),
+    };
     let states = super::in_parallel(etas.len(), 1, |k| measure(d, etas[k], n, per_particle, options.seed + k as u64))?;
-    let checks: Vec<Check> = states.iter().flat_map(checks_for).collect();
+    let dilute = measure_dilute(d, dilute_n, dilute_per_particle, options.seed + etas.len() as u64)?;
+    let mut checks: Vec<Check> = states.iter().flat_map(checks_for).collect();
+    checks.push(dilute_check(&dilute));
     let dir = options.plot_dir(NAME)?;
     let kind = if d == 2 { "disks" } else { "spheres" };
     let curves = |pick: fn(&StructureState) -> &Vec<[f64; 2]>| -> Vec<Series> {
@@ -209,6 +346,30 @@ pub fn run(options: &Options) -> Result<ExperimentResult, ExperimentError> {
             legend_left: false,
         },
         &dir.join("sk.svg"),
+    )?;
+    let density = crate::lab::collision_rate::number_density(d, DILUTE_ETA);
+    draw(
+        &Chart {
+            title: format!("g(r) of a dilute fluid (η = {DILUTE_ETA}, {kind}) against its first order in density"),
+            x_label: "r (σ)".into(),
+            y_label: "g(r) (dimensionless)".into(),
+            legend_left: false,
+            series: vec![
+                Series::errors(
+                    "measured (bins of 0.1σ)",
+                    dilute.bins.iter().map(|b| (0.5 * (b.r[0] + b.r[1]), b.g)).collect(),
+                    dilute.bins.iter().map(|b| b.error).collect(),
+                ),
+                Series::line(
+                    "1 + n·X(r) (Nijboer & van Hove)",
+                    (0..=120)
+                        .map(|k| 1.0 + k as f64 / 100.0)
+                        .map(|r| (r, crate::theory::g_first_order(d, density, r)))
+                        .collect(),
+                ),
+            ],
+        },
+        &dir.join("dilute.svg"),
     )?;
     let top = etas.iter().copied().fold(0.0, f64::max) + 0.02;
     let line = |f: &dyn Fn(f64) -> f64| (1..=100).map(|k| k as f64 * top / 100.0).map(|e| (e, f(e))).collect();
@@ -241,9 +402,10 @@ pub fn run(options: &Options) -> Result<ExperimentResult, ExperimentError> {
     Ok(options.result(
         NAME,
         json!({ "dimension": d, "n_particles": n, "packing_fractions": etas, "boundary": "periodic", "kT": 1.0,
-            "production_collisions_per_particle": per_particle }),
-        json!({ "states": states }),
+            "production_collisions_per_particle": per_particle, "dilute": { "eta": DILUTE_ETA, "n_particles": dilute_n,
+            "production_collisions_per_particle": dilute_per_particle, "rdf_r_max": 2.5, "rdf_bins": 250 } }),
+        json!({ "states": states, "dilute": dilute }),
         checks,
-        vec!["rdf.svg".into(), "sk.svg".into(), "contact_and_s0.svg".into()],
+        vec!["rdf.svg".into(), "sk.svg".into(), "contact_and_s0.svg".into(), "dilute.svg".into()],
     ))
 }

@@ -546,7 +546,19 @@ pub(crate) fn for_pairs_within<const D: usize>(
             .map(|a| if counts[a] == 1 { lengths[a] } else { (2 * m + 1) as f64 * lengths[a] / counts[a] as f64 })
             .product()
     };
-    let reach = (1..=3).min_by(|&x, &y| searched(x).total_cmp(&searched(y))).expect("three choices");
+    // The work of a walk: the pairs it compares (the searched volume at the particles'
+    // density, half of it per particle) and, per occupied cell, its half of the neighbour
+    // offsets, each some divisions — about four pairs' worth. Dense fluids choose by the
+    // volume alone; a dilute one, whose finest cells are mostly empty or single, takes the
+    // coarsest (η = 0.05: 3375 spheres, m = 3 cost 5.7 ms a sample, m = 1 0.5 ms).
+    let n = positions.len() as f64;
+    let density = n / lengths.iter().product::<f64>();
+    let work = |m: usize| -> f64 {
+        let cells = counts_for(m).iter().product::<usize>() as f64;
+        let offsets = ((2 * m + 1).pow(D as u32) - 1) as f64 / 2.0;
+        0.5 * n * density * searched(m) + 4.0 * n.min(cells) * (offsets + 1.0)
+    };
+    let reach = (1..=3).min_by(|&x, &y| work(x).total_cmp(&work(y))).expect("three choices");
     let counts = counts_for(reach);
     let single: [bool; D] = std::array::from_fn(|a| counts[a] == 1);
     let wrap = |x: f64, a: usize| if periodic[a] { x - (x / lengths[a]).floor() * lengths[a] } else { x };
@@ -617,6 +629,11 @@ pub(crate) fn for_pairs_within<const D: usize>(
         }
     };
     for c in 0..total {
+        // A dilute fluid leaves most cells empty: walking their offsets cost a fluid at
+        // η = 0.05 (3375 spheres, 59 319 cells) 55 ms a sample.
+        if start[c] == start[c + 1] {
+            continue;
+        }
         let mut m = [0usize; D];
         let mut rest = c;
         for a in (0..D).rev() {
