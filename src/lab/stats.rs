@@ -88,9 +88,7 @@ pub fn line_root_with_error(points: &[(f64, f64)], blocks: usize) -> Option<(Lin
         let rest: Vec<(f64, f64)> = points[..k * size].iter().chain(&points[end..]).copied().collect();
         roots.push(fit_line(&rest)?.root());
     }
-    let mean = roots.iter().sum::<f64>() / blocks as f64;
-    let variance = (blocks - 1) as f64 / blocks as f64 * roots.iter().map(|r| (r - mean).powi(2)).sum::<f64>();
-    Some((fit, fit.root(), variance.sqrt()))
+    Some((fit, fit.root(), crate::observe::blocks::jackknife_error(&roots)))
 }
 
 /// The mean of independent values and its standard error (sample standard deviation over

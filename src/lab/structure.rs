@@ -158,12 +158,13 @@ pub fn dilute_state(d: usize, eta: f64, n: usize, collisions: u64, rdf: &crate::
         .map(|j| {
             let fine = start + j * per..start + (j + 1) * per;
             let counts: u64 = rdf.counts[0][fine.clone()].iter().sum();
-            let expected: f64 = ideal[fine.clone()].iter().sum::<f64>() * m;
+            let ideal_sum: f64 = ideal[fine.clone()].iter().sum();
+            let expected = ideal_sum * m;
             let first_order = fine
                 .clone()
                 .map(|k| ideal[k] * crate::theory::g_first_order(d, density, (k as f64 + 0.5) * dr))
                 .sum::<f64>()
-                / ideal[fine.clone()].iter().sum::<f64>();
+                / ideal_sum;
             let (g, error) = (counts as f64 / expected, (counts as f64).sqrt() / expected);
             ShellBin {
                 r: [fine.start as f64 * dr, fine.end as f64 * dr],

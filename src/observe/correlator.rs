@@ -283,13 +283,7 @@ impl Correlator {
             .map(|b| f(&mean_without(self, Some(b)), &mean_without(other, Some(b))))
             .filter(|x| x.is_finite())
             .collect();
-        let b = partial.len() as f64;
-        if partial.len() < 2 {
-            return (all, f64::NAN);
-        }
-        let mean = partial.iter().sum::<f64>() / b;
-        let var = (b - 1.0) / b * partial.iter().map(|x| (x - mean).powi(2)).sum::<f64>();
-        (all, var.sqrt())
+        (all, super::blocks::jackknife_error(&partial))
     }
 
     /// The lag index of the longest lag a value is read at: averaged over at least `origins`

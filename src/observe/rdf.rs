@@ -137,7 +137,7 @@ pub struct Rdf {
     pub counts: Vec<Vec<u64>>,
     /// Per species pair, the counts of its contact window's bins, sample after sample
     /// (a window's worth per sample; empty without a window).
-    pub window_counts: Vec<Vec<u32>>,
+    pub window_counts: Vec<Vec<u64>>,
     /// Per species pair, the contact window: its first bin, the fit's weights and the bins'
     /// ideal counts (None: fewer than 3 bins in the window).
     pub windows: Vec<Option<Window>>,
@@ -173,7 +173,7 @@ impl Window {
 
     /// The contact value from `per_sample` (the window's counts, one sample after another)
     /// and its delete-one-block jackknife error over `blocks` blocks of consecutive samples.
-    fn estimate(&self, per_sample: &[u32], blocks: usize) -> (f64, f64) {
+    fn estimate(&self, per_sample: &[u64], blocks: usize) -> (f64, f64) {
         let n = self.weights.len();
         let samples = per_sample.len() / n;
         if samples == 0 {
@@ -183,22 +183,22 @@ impl Window {
         let mut sums = vec![vec![0u64; n]; blocks];
         for (s, counts) in per_sample.chunks(n).enumerate() {
             for (total, &c) in sums[s * blocks / samples].iter_mut().zip(counts) {
-                *total += c as u64;
+                *total += c;
             }
         }
         let totals: Vec<u64> = (0..n).map(|j| sums.iter().map(|b| b[j]).sum()).collect();
         let size = |b: usize| ((b + 1) * samples).div_ceil(blocks) - (b * samples).div_ceil(blocks);
-        let without = |b: usize| -> Vec<u64> { totals.iter().zip(&sums[b]).map(|(t, s)| t - s).collect() };
+        let without: Vec<Vec<u64>> =
+            sums.iter().map(|block| totals.iter().zip(block).map(|(t, s)| t - s).collect()).collect();
         // The logarithm needs every bin to hold pairs in every leave-one-out total.
-        let log = blocks >= 2 && (0..blocks).all(|b| without(b).iter().all(|&c| c > 0));
+        let log = blocks >= 2 && without.iter().all(|counts| counts.iter().all(|&c| c > 0));
         let value = self.contact(&totals, samples as u64, log);
-        if blocks < 2 {
-            return (value, f64::NAN);
-        }
-        let theta: Vec<f64> = (0..blocks).map(|b| self.contact(&without(b), (samples - size(b)) as u64, log)).collect();
-        let mean = theta.iter().sum::<f64>() / blocks as f64;
-        let var = theta.iter().map(|t| (t - mean).powi(2)).sum::<f64>() * (blocks - 1) as f64 / blocks as f64;
-        (value, var.sqrt())
+        let theta: Vec<f64> = without
+            .iter()
+            .enumerate()
+            .map(|(b, counts)| self.contact(counts, (samples - size(b)) as u64, log))
+            .collect();
+        (value, super::blocks::jackknife_error(&theta))
     }
 }
 
@@ -299,7 +299,7 @@ impl Rdf {
         for (q, counts) in this.iter().enumerate() {
             if let Some(w) = &self.windows[q] {
                 let window = &counts[w.first..w.first + w.weights.len()];
-                self.window_counts[q].extend(window.iter().map(|&c| u32::try_from(c).unwrap_or(u32::MAX)));
+                self.window_counts[q].extend_from_slice(window);
             }
             for (total, c) in self.counts[q].iter_mut().zip(counts) {
                 *total += c;
@@ -744,12 +744,12 @@ mod tests {
         let mean: Vec<f64> =
             (0..n).map(|j| w.ideal[j] * a * (-kappa * ((w.first + j) as f64 + 0.5 - 100.0) * dr).exp()).collect();
         let scale = 1e9 / mean[0];
-        let exact: Vec<u32> = (0..40).flat_map(|_| mean.iter().map(|m| (m * scale).round() as u32)).collect();
+        let exact: Vec<u64> = (0..40).flat_map(|_| mean.iter().map(|m| (m * scale).round() as u64)).collect();
         let scaled = Window { ideal: w.ideal.iter().map(|i| i * scale).collect(), ..w.clone() };
         let (g, error) = scaled.estimate(&exact, 20);
         assert!((g / a - 1.0).abs() < 1e-6, "ln-g fit {g} for {a}");
         assert!(error < 1e-9, "identical samples: {error}");
-        let linear = scaled.contact(&exact.iter().take(n).map(|&c| c as u64).collect::<Vec<_>>(), 1, false);
+        let linear = scaled.contact(&exact[..n], 1, false);
         assert!(a - linear > 5e-3, "the quadratic in g: {linear} (no bias to remove?)");
         // Poisson counts at a realistic scale: about 400 pairs per bin per sample.
         let scale = 400.0 / mean[0];
@@ -757,10 +757,10 @@ mod tests {
         let mut rng = rand::rngs::StdRng::seed_from_u64(7);
         let runs: Vec<(f64, f64)> = (0..200)
             .map(|_| {
-                let counts: Vec<u32> = (0..100)
+                let counts: Vec<u64> = (0..100)
                     .flat_map(|_| {
                         mean.iter()
-                            .map(|m| Poisson::new(m * scale).unwrap().sample(&mut rng) as u32)
+                            .map(|m| Poisson::new(m * scale).unwrap().sample(&mut rng) as u64)
                             .collect::<Vec<_>>()
                     })
                     .collect();
@@ -779,11 +779,8 @@ mod tests {
             sparse[s * n + 3] = 0;
         }
         let (g, _) = scaled.estimate(&sparse, 20);
-        let by_g = scaled.contact(
-            &(0..n).map(|j| (0..40).map(|s| sparse[s * n + j] as u64).sum()).collect::<Vec<_>>(),
-            40,
-            false,
-        );
+        let by_g =
+            scaled.contact(&(0..n).map(|j| (0..40).map(|s| sparse[s * n + j]).sum()).collect::<Vec<_>>(), 40, false);
         assert_eq!(g, by_g);
     }
 
