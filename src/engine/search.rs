@@ -12,6 +12,12 @@
 //! to the bit), else pinned to one ulp ([`Lanes::pinned`]), else from the exact root. A lower
 //! end equal to the bound is kept: it may tie and win.
 //!
+//! The two partners of a collision are searched side by side
+//! ([`bracket_both`](Search::bracket_both), then [`settle_both`](Search::settle_both)), their
+//! chunks in turn: each search is a chain of dependent steps, and two independent chains keep
+//! the core busy where one left it waiting. The rare exact root stays out of line
+//! ([`Lanes::predict`]), so that the code the search runs every time stays compact.
+//!
 //! Short periodic axes (several images of one pair) and crowds of more than [`NEAR`]
 //! neighbours take the scalar search, one pair at a time with a shrinking horizon; same
 //! events.
@@ -34,25 +40,112 @@ pub(crate) const NEAR: usize = 64;
 const HITS: usize = 32;
 
 /// The batch search's scratch space, kept so that no prediction spends time initialising a
-/// kilobyte of stack; and whether the batch is used at all.
-///
-/// Aligned to a cache line, each array at a multiple of 64 bytes: the lanes are read and
-/// written eight f64 at a time, and a vector that straddles two lines costs two accesses.
+/// kilobyte of stack — two sides of it, so that both partners of a collision can be searched
+/// side by side ([`bracket_both`](Search::bracket_both)); and whether the batch is used at
+/// all.
 #[derive(Clone, Debug)]
-#[repr(C, align(64))]
 pub(crate) struct Search<const D: usize> {
-    lo: [f64; NEAR],
-    hi: [f64; NEAR],
-    lanes: [Lanes<D>; NEAR / LANES],
+    sides: [Side<D>; 2],
     /// Search with the batch kernel; false when an axis is short (several images per pair)
     /// — and in the test that compares both searches.
     pub(crate) batch: bool,
 }
 
+/// One particle's brackets and balls.
+///
+/// Aligned to a cache line, each array at a multiple of 64 bytes: the lanes are read and
+/// written eight f64 at a time, and a vector that straddles two lines costs two accesses.
+#[derive(Clone, Debug)]
+#[repr(C, align(64))]
+struct Side<const D: usize> {
+    lo: [f64; NEAR],
+    hi: [f64; NEAR],
+    lanes: [Lanes<D>; NEAR / LANES],
+}
+
+impl<const D: usize> Side<D> {
+    fn new() -> Self {
+        Side { lo: [f64::INFINITY; NEAR], hi: [f64::INFINITY; NEAR], lanes: [Lanes::default(); NEAR / LANES] }
+    }
+
+    /// Pass 1 for the chunk `start..start + LANES` of particle `i`'s `n_near` neighbours
+    /// `near`: its brackets, and the smallest upper end.
+    #[inline(always)]
+    #[allow(clippy::too_many_arguments)]
+    fn bracket_chunk(
+        &mut self,
+        particles: &[Particle<D>],
+        sim_box: &SimBox<D>,
+        now: f64,
+        i: usize,
+        near: &[u32; NEAR],
+        n_near: usize,
+        start: usize,
+    ) -> f64 {
+        let chunk = start..start + LANES;
+        let js = near[chunk.clone()].try_into().expect("LANES wide");
+        let (lo, hi) = (&mut self.lo[chunk.clone()], &mut self.hi[chunk]);
+        let (lo, hi) = (lo.try_into().expect("LANES wide"), hi.try_into().expect("LANES wide"));
+        let balls = &mut self.lanes[start / LANES];
+        bracket_neighbours(particles, i, js, n_near - start, sim_box, now, lo, hi, balls)
+    }
+
+    /// Pass 2: the candidates whose bracket reaches down to `bound`, offered to `best` (the
+    /// event of `owner`). Which lanes are candidates is a coin toss for the branch predictor:
+    /// they are marked without branches first, one bit each, and the bits are visited lowest
+    /// first. Only the neighbours' lanes count: the padding of the last chunk brackets to
+    /// [+∞, +∞] too, which an infinite bound (nothing else pending, as for a disk at rest)
+    /// would reach.
+    #[inline(always)]
+    #[allow(clippy::too_many_arguments)]
+    fn settle(
+        &self,
+        particles: &[Particle<D>],
+        now: f64,
+        owner: u32,
+        near: &[u32; NEAR],
+        n_near: usize,
+        bound: f64,
+        best: &mut Event,
+    ) {
+        let lanes = n_near.div_ceil(LANES) * LANES;
+        let Side { lo, hi, lanes: balls } = self;
+        const { assert!(NEAR <= 64) };
+        let mut marked = 0u64;
+        for (k, &lo) in lo[..lanes].iter().enumerate() {
+            marked |= ((lo <= bound) as u64) << k;
+        }
+        marked &= if n_near < 64 { (1u64 << n_near) - 1 } else { u64::MAX };
+        while marked != 0 {
+            let k = marked.trailing_zeros() as usize;
+            marked &= marked - 1;
+            let (j, lo, hi) = (near[k] as usize, lo[k], hi[k]);
+            let q = &particles[j];
+            let lanes = &balls[k / LANES];
+            let t = if lo == hi && lo < f64::INFINITY {
+                // Both ends round to the same absolute time: that is the time.
+                Some(lo)
+            } else if let Some(t) = (hi < f64::INFINITY).then(|| lanes.pinned(k % LANES, lo, hi, now)).flatten() {
+                // Pinned to one ulp, and settled (`Lanes::pinned`).
+                Some(t)
+            } else {
+                // The exact root, from the balls the brackets were built from.
+                lanes.predict(k % LANES, now)
+            };
+            if let Some(t) = t {
+                let e = Event { time: t, kind: EventKind::Pair { partner: j as u32, partner_events: q.events } };
+                if e.before(owner, best, owner) {
+                    *best = e;
+                }
+            }
+        }
+    }
+}
+
 impl<const D: usize> Search<D> {
     /// The search for a box with (`batch = false`) or without short periodic axes.
     pub(crate) fn new(batch: bool) -> Self {
-        Search { batch, lo: [f64::INFINITY; NEAR], hi: [f64::INFINITY; NEAR], lanes: [Lanes::default(); NEAR / LANES] }
+        Search { batch, sides: [Side::new(), Side::new()] }
     }
 
     /// Particle `i`'s neighbours but `skip`, for the batch search: how many, or `None` when
@@ -88,12 +181,6 @@ impl<const D: usize> Search<D> {
         radii: Radii,
         best: &mut Event,
     ) {
-        let owner = i as u32;
-        let consider = |best: &mut Event, e: Event| {
-            if e.before(owner, best, owner) {
-                *best = e;
-            }
-        };
         let Some(n_near) = gathered else {
             return scalar(particles, sim_box, short, neighbours, now, i, skip, radii, best);
         };
@@ -101,51 +188,65 @@ impl<const D: usize> Search<D> {
         // earliest time some candidate is certain to reach. Every chunk is LANES wide (the
         // lanes past the neighbours give [+∞, +∞]), so that no loop below ends at a count
         // the branch predictor cannot know.
-        let lanes = n_near.div_ceil(LANES) * LANES;
-        let Search { lo, hi, lanes: balls, .. } = self;
+        let side = &mut self.sides[0];
         let mut bound = best.time;
-        for start in (0..lanes).step_by(LANES) {
-            let chunk = start..start + LANES;
-            let js = near[chunk.clone()].try_into().expect("LANES wide");
-            let (lo, hi) = (&mut lo[chunk.clone()], &mut hi[chunk]);
-            let (lo, hi) = (lo.try_into().expect("LANES wide"), hi.try_into().expect("LANES wide"));
-            let balls = &mut balls[start / LANES];
-            let earliest = bracket_neighbours(particles, i, js, n_near - start, sim_box, now, lo, hi, balls);
-            bound = bound.min(earliest);
+        for start in (0..n_near.div_ceil(LANES) * LANES).step_by(LANES) {
+            bound = bound.min(side.bracket_chunk(particles, sim_box, now, i, near, n_near, start));
         }
-        let (lo, hi, balls) = (&*lo, &*hi, &*balls);
-        // Pass 2: the candidates whose bracket reaches down to the bound. Which lanes are
-        // candidates is a coin toss for the branch predictor: they are marked without
-        // branches first, one bit each, and the bits are visited lowest first. Only the
-        // neighbours' lanes count: the padding of the last chunk brackets to [+∞, +∞] too,
-        // which an infinite bound (nothing else pending, as for a disk at rest) would reach.
-        const { assert!(NEAR <= 64) };
-        let mut marked = 0u64;
-        for (k, &lo) in lo[..lanes].iter().enumerate() {
-            marked |= ((lo <= bound) as u64) << k;
-        }
-        marked &= if n_near < 64 { (1u64 << n_near) - 1 } else { u64::MAX };
-        while marked != 0 {
-            let k = marked.trailing_zeros() as usize;
-            marked &= marked - 1;
-            let (j, lo, hi) = (near[k] as usize, lo[k], hi[k]);
-            let q = &particles[j];
-            let lanes = &balls[k / LANES];
-            let t = if lo == hi && lo < f64::INFINITY {
-                // Both ends round to the same absolute time: that is the time.
-                Some(lo)
-            } else if let Some(t) = (hi < f64::INFINITY).then(|| lanes.pinned(k % LANES, lo, hi, now)).flatten() {
-                // Pinned to one ulp, and settled (`Lanes::pinned`).
-                Some(t)
-            } else {
-                // The exact root, from the balls the brackets were built from.
-                lanes.predict(k % LANES, now)
-            };
-            if let Some(t) = t {
-                let kind = EventKind::Pair { partner: j as u32, partner_events: q.events };
-                consider(best, Event { time: t, kind });
+        side.settle(particles, now, i as u32, near, n_near, bound, best);
+    }
+
+    /// Pass 1 of [`earliest`](Self::earliest) for two particles at once — the partners of a
+    /// collision, `i[0]` and `i[1]`, both gathered by the batch (`gathered[k]` neighbours in
+    /// `near[k]`), their events so far `best[k]` —; returns their bounds, for
+    /// [`settle_both`](Self::settle_both). Their chunks are bracketed in turn, one of each: a
+    /// prediction is a chain of dependent steps (the gather, the motion, the filter, a square
+    /// root and a division, the smallest upper end, the pin), and two independent chains
+    /// side by side keep the core busy where one alone left it waiting (measured with
+    /// alternating runs: `benches/HISTORY.md`).
+    #[inline(always)]
+    pub(crate) fn bracket_both(
+        &mut self,
+        particles: &[Particle<D>],
+        sim_box: &SimBox<D>,
+        now: f64,
+        i: [usize; 2],
+        near: [&[u32; NEAR]; 2],
+        gathered: [usize; 2],
+        best: [&Event; 2],
+    ) -> [f64; 2] {
+        let [a, b] = &mut self.sides;
+        let (mut bound_a, mut bound_b) = (best[0].time, best[1].time);
+        let chunks = [gathered[0].div_ceil(LANES), gathered[1].div_ceil(LANES)];
+        for c in 0..chunks[0].max(chunks[1]) {
+            let start = c * LANES;
+            if c < chunks[0] {
+                bound_a = bound_a.min(a.bracket_chunk(particles, sim_box, now, i[0], near[0], gathered[0], start));
+            }
+            if c < chunks[1] {
+                bound_b = bound_b.min(b.bracket_chunk(particles, sim_box, now, i[1], near[1], gathered[1], start));
             }
         }
+        [bound_a, bound_b]
+    }
+
+    /// Pass 2 after [`bracket_both`](Self::bracket_both), with its arguments and bounds: the
+    /// same events as two calls of [`earliest`](Self::earliest).
+    #[inline(always)]
+    #[allow(clippy::too_many_arguments)]
+    pub(crate) fn settle_both(
+        &self,
+        particles: &[Particle<D>],
+        now: f64,
+        i: [usize; 2],
+        near: [&[u32; NEAR]; 2],
+        gathered: [usize; 2],
+        bounds: [f64; 2],
+        best: [&mut Event; 2],
+    ) {
+        let [best_a, best_b] = best;
+        self.sides[0].settle(particles, now, i[0] as u32, near[0], gathered[0], bounds[0], best_a);
+        self.sides[1].settle(particles, now, i[1] as u32, near[1], gathered[1], bounds[1], best_b);
     }
 }
 
@@ -332,7 +433,11 @@ impl<const D: usize> Lanes<D> {
     /// [`pair::predict`] for the pair in lane `k` — the same number, as the balls are the
     /// same (and with an infinite horizon the kernel's `contact_time_within` is
     /// [`contact_time_unchecked`]), without forming them again from the particles.
-    #[inline]
+    // Out of line and cold: asked for only where a pin does not settle the time (rarely),
+    // and inlined, its double-double root made the search three times the size (10 KB of
+    // code in 3D; `benches/HISTORY.md`, "Two partners side by side").
+    #[inline(never)]
+    #[cold]
     pub fn predict(&self, k: usize, now: f64) -> Option<f64> {
         pair::absolute(contact_time_unchecked(&self.first.get(k), &self.second.get(k)), self.t0[k]).map(|t| t.max(now))
     }

@@ -382,14 +382,28 @@ impl<const D: usize> Neighbours<D> {
             self.cells.shift(i, axis, up);
             return;
         }
-        // Leave every old neighbour's list (a crowded particle does not know them: everyone
-        // in the cells around is asked, and `drop` ignores those without it).
+        // The new neighbours first, then leave every old neighbour's list and join every new
+        // one's (neither changes what the scan reads): the scan's walk of the cells gives
+        // the old neighbours' rows, asked for before the event (`Timing::leaving`), time to
+        // arrive. A row both old and new is left before it is joined, as in either order of
+        // the two steps.
         let mut old = [List::EMPTY; lists::MAX_ROWS];
         old[..Self::ROWS].copy_from_slice(self.rows(i));
         let old = Rows(&old[..Self::ROWS]);
+        let from = self.cell(i);
+        let centre = p.position_at(t);
+        let to = self.cells.locate(&centre);
+        if from != to {
+            self.cells.remove(i, &from);
+            self.cells.insert(i, &to);
+        }
+        self.centres[i] = centre;
+        self.scan(i);
+        // A crowded particle does not know its old neighbours: everyone in the cells around
+        // its old centre is asked, and `drop` ignores those without it.
         if old.crowded() {
-            let (cell, rows) = (self.cell(i), Self::ROWS);
-            for j in self.cells.neighbours(cell) {
+            let rows = Self::ROWS;
+            for j in self.cells.neighbours(from) {
                 if j != i {
                     lists::drop(&mut self.lists[j * rows..(j + 1) * rows], i as u32);
                 }
@@ -399,14 +413,6 @@ impl<const D: usize> Neighbours<D> {
                 lists::drop(self.rows_mut(j), i as u32);
             }
         }
-        let centre = p.position_at(t);
-        let (from, to) = (self.cell(i), self.cells.locate(&centre));
-        if from != to {
-            self.cells.remove(i, &from);
-            self.cells.insert(i, &to);
-        }
-        self.centres[i] = centre;
-        self.scan(i);
         let found = std::mem::take(&mut self.scratch);
         for &j in &found {
             lists::add(self.rows_mut(j as usize), i as u32);
@@ -488,7 +494,7 @@ impl<const D: usize> Neighbours<D> {
     #[inline]
     pub fn gather(&self, i: usize, skip: usize, out: &mut [u32]) -> Option<usize> {
         if !self.listed || self.is_crowded(i) {
-            return self.cells.gather(&self.cell(i), i, skip, out);
+            return self.gather_cells(i, skip, out);
         }
         // Row by row (one in 2D, two in 3D: the loops unroll), without branches.
         let mut len = 0;
@@ -500,6 +506,13 @@ impl<const D: usize> Neighbours<D> {
             }
         }
         Some(len)
+    }
+
+    /// [`gather`](Self::gather) from the cells around `i`: out of line, so that the list's
+    /// copy stays a few instructions where it is inlined.
+    #[inline(never)]
+    fn gather_cells(&self, i: usize, skip: usize, out: &mut [u32]) -> Option<usize> {
+        self.cells.gather(&self.cell(i), i, skip, out)
     }
 
     /// The particles that can touch `i` before it next rebuilds — its list, or (crowded, or

@@ -76,6 +76,16 @@ pub(super) fn own_rows<const D: usize>(at: &Reading<'_, D>, a: usize, b: usize) 
     row(at, b);
 }
 
+/// Without the lookahead, before particle `a` leaves its skin: the rows of its old
+/// neighbours, which its rebuild leaves after scanning the cells around its new centre (the
+/// scan takes long enough for them to arrive).
+#[inline(always)]
+pub(super) fn old_rows<const D: usize>(at: &Reading<'_, D>, a: usize) {
+    if let Some(row) = at.neighbours.row(a) {
+        row.for_each_member(|j| prefetch(&at.neighbours.row(j).expect("lists").blocks()[0]));
+    }
+}
+
 /// Stage one (see the module docs): the guess of the next event after `a` and `b`'s, with
 /// its record, pending event and row on their way.
 pub(super) fn first_stage<const D: usize>(at: &Reading<'_, D>, a: usize, b: usize) -> usize {

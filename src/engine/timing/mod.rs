@@ -4,11 +4,12 @@
 //! starts. Nothing here changes a result: with every part of it on or off, the events are the
 //! same bit for bit (tested), only the time differs.
 //!
-//! The engine meets it through [`Timing`] alone, at four points: the store its structures
-//! build their large arrays in ([`Timing::store`]) and three places
+//! The engine meets it through [`Timing`] alone, at five points: the store its structures
+//! build their large arrays in ([`Timing::store`]) and four places
 //! in a step — before an event is resolved
-//! ([`Timing::begin`]), between the two predictions that follow a collision
-//! ([`Timing::middle`]) and after them ([`Timing::end`]). It reads the engine's structures
+//! ([`Timing::begin`]; [`Timing::leaving`] too when a particle leaves its skin), between the
+//! two predictions that follow a collision ([`Timing::middle`]) and after them
+//! ([`Timing::end`]). It reads the engine's structures
 //! through [`Reading`] and never writes them; the structures expose where their data lives,
 //! never a hint of their own.
 
@@ -103,6 +104,15 @@ impl Timing {
                 lookahead::own_rows(at, a, b);
             }
             None
+        }
+    }
+
+    /// Before particle `a` leaves its skin (a rebuild): without the lookahead, the rows of
+    /// its old neighbours (with it, stage two of the step before has asked for them).
+    #[inline(always)]
+    pub(crate) fn leaving<const D: usize>(&self, at: &Reading<'_, D>, a: usize) {
+        if !self.lookahead {
+            lookahead::old_rows(at, a);
         }
     }
 
