@@ -367,7 +367,7 @@ pub fn bracket_neighbours<const D: usize>(
     // array stored lane by lane and read back as one vector stalls on store forwarding).
     let mut decided = true;
     for k in 0..LANES {
-        let t = p.time.max(qt[k]);
+        let t = larger(p.time, qt[k]);
         t0[k] = t;
         for a in 0..D {
             let d = motion::coordinate(qx[a][k], qv[a][k], now - qt[k])
@@ -399,10 +399,14 @@ pub fn bracket_neighbours<const D: usize>(
         }
     }
     contact_brackets(first, second, lo, hi);
+    // Absolute times, no earlier than `now`, and +∞ past the neighbours: selects on values
+    // computed in every lane, which compile to vector compares and blends (a branch on
+    // `k < len` per lane mispredicts in the last chunk, whose length varies).
+    let len = len as f64;
     for k in 0..LANES {
-        let used = k < len;
-        lo[k] = if used { (t0[k] + lo[k]).max(now) } else { f64::INFINITY };
-        hi[k] = if used { (t0[k] + hi[k]).max(now) } else { f64::INFINITY };
+        let floor = if (k as f64) < len { now } else { f64::INFINITY };
+        lo[k] = larger(t0[k] + lo[k], floor);
+        hi[k] = larger(t0[k] + hi[k], floor);
     }
     // Pairwise, while the ends are still in registers (a fold over the stored array is a
     // serial chain of minima behind store-to-load forwarding).
@@ -412,10 +416,24 @@ pub fn bracket_neighbours<const D: usize>(
     while width > 1 {
         width /= 2;
         for k in 0..width {
-            m[k] = m[k].min(m[k + width]);
+            m[k] = smaller(m[k], m[k + width]);
         }
     }
     m[0]
+}
+
+/// The larger of two numbers that are not NaN (as `f64::max`, one vector instruction:
+/// `f64::max` also handles NaN, which costs a compare and a blend more per lane). Here the
+/// times and ends are never NaN: finite times plus ends in `[0, +∞]`.
+#[inline(always)]
+fn larger(a: f64, b: f64) -> f64 {
+    if a > b { a } else { b }
+}
+
+/// The smaller of two numbers that are not NaN (see [`larger`]).
+#[inline(always)]
+fn smaller(a: f64, b: f64) -> f64 {
+    if a < b { a } else { b }
 }
 
 /// The balls of one chunk of [`bracket_neighbours`]' lanes, and the `t0` of each.

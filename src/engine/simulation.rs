@@ -807,6 +807,9 @@ impl<const D: usize> Simulation<D> {
     fn predict_one(&mut self, i: usize, guess: Option<usize>) {
         let mut near = [0u32; NEAR];
         let gathered = self.search.gather(&self.neighbours, i, i, &mut near);
+        if let Some(n) = gathered {
+            self.timing.searching(&self.reading(), &near[..n]);
+        }
         let ahead = self.timing.middle(&self.reading(), guess);
         self.predict_among(i, i, &near, gathered);
         self.timing.end(&self.reading(), ahead.as_ref());
@@ -833,6 +836,8 @@ impl<const D: usize> Simulation<D> {
         };
         // Both by the batch: searched side by side (`Search::bracket_both`), the timing
         // room's second stage between the brackets and the candidates' exact times.
+        self.timing.searching(&self.reading(), &near_i[..n_i]);
+        self.timing.searching(&self.reading(), &near_j[..n_j]);
         let (mut best_i, mut best_j) = (self.alone(i), self.alone(j));
         let (near, gathered) = ([&near_i, &near_j], [n_i, n_j]);
         let bounds = self.search.bracket_both(

@@ -386,6 +386,37 @@ impl<const D: usize> Cells<D> {
         Members { next: &self.next, at: self.head[c as usize] }
     }
 
+    /// Calls `f` with every particle in the cells `cells` (flat indices, at most 27, as from
+    /// [`Cells::around`]), the cells' lists walked side by side: one link of each list still
+    /// unfinished per round. A list is a chain of dependent loads, and walked one after
+    /// another the lists of a neighbourhood cost one load latency per member (a cache miss
+    /// each, at large N); side by side, the links of one round are independent, and the walk
+    /// costs one latency per round — as many as the longest list has members. The order is
+    /// round by round, not cell by cell.
+    #[inline(always)]
+    pub fn for_each_member_side_by_side(&self, cells: &[u32], mut f: impl FnMut(u32)) {
+        let mut at = [NONE; 27];
+        let mut active = 0;
+        for &c in cells {
+            let j = self.head[c as usize];
+            at[active] = j;
+            active += (j != NONE) as usize;
+        }
+        // Each round visits the unfinished lists' current members and keeps, packed to the
+        // front without branches, those whose lists go on.
+        while active > 0 {
+            let mut kept = 0;
+            for k in 0..active {
+                let j = at[k];
+                f(j);
+                let next = self.next[j as usize];
+                at[kept] = next;
+                kept += (next != NONE) as usize;
+            }
+            active = kept;
+        }
+    }
+
     /// Writes the particles in the cells around cell `m`, except `i` and `skip`, into `out`
     /// and returns how many — or `None` when they do not fit (`out.len()` or more).
     ///
@@ -542,6 +573,35 @@ mod tests {
     }
 
     /// A gather that does not fit says so instead of writing past `out` or dropping members.
+    /// The walk of several cells' lists side by side visits every member of those cells
+    /// once (lists of different lengths, empty cells among them), as the walk one cell after
+    /// another does.
+    #[test]
+    fn side_by_side_walk_visits_every_member_once() {
+        let sim_box = SimBox { lengths: SVector::from([6.0, 6.0, 6.0]), boundary: [Boundary::Periodic; 3] };
+        let mut rng = Xoshiro256PlusPlus::seed_from_u64(3);
+        // Crowded near one corner, so that lists range from empty to long.
+        let positions: Vec<SVector<f64, 3>> = (0..300)
+            .map(|_| SVector::from(std::array::from_fn(|_| rng.random_range(0.0f64..1.0).powi(3) * 6.0)))
+            .collect();
+        let cells = Cells::new(&sim_box, 1.0, positions.iter().copied());
+        let mut lengths = std::collections::BTreeSet::new();
+        let n = cells.counts()[0] as u32;
+        for x in 0..n {
+            for y in 0..n {
+                let around = cells.around(&[x, y, (x + y) % n]);
+                let mut one_by_one: Vec<u32> = around.as_slice().iter().flat_map(|&c| cells.members(c)).collect();
+                let mut side_by_side = Vec::new();
+                cells.for_each_member_side_by_side(around.as_slice(), |j| side_by_side.push(j));
+                one_by_one.sort_unstable();
+                side_by_side.sort_unstable();
+                assert_eq!(side_by_side, one_by_one);
+                lengths.extend(around.as_slice().iter().map(|&c| cells.members(c).count()));
+            }
+        }
+        assert!(lengths.contains(&0) && lengths.iter().any(|&k| k > 5), "{lengths:?}");
+    }
+
     #[test]
     fn gather_reports_when_the_members_do_not_fit() {
         let sim_box = SimBox { lengths: SVector::from([10.5, 10.5]), boundary: [Boundary::Periodic; 2] };

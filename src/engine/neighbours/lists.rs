@@ -149,6 +149,17 @@ pub(crate) fn fill(rows: &mut [List], members: &[u32]) {
     }
 }
 
+/// The first entries of `entries` in a block as wide as the widest list, `NONE` after them:
+/// whether a particle is among them is then one vector compare.
+#[inline(always)]
+pub(crate) fn block(entries: impl IntoIterator<Item = u32>) -> [u32; MAX_ROWS * CAPACITY] {
+    let mut block = [NONE; MAX_ROWS * CAPACITY];
+    for (slot, j) in block.iter_mut().zip(entries) {
+        *slot = j;
+    }
+    block
+}
+
 /// Marks `rows` crowded.
 pub(crate) fn set_crowded(rows: &mut [List]) {
     rows.fill(List::EMPTY);

@@ -357,15 +357,17 @@ impl<const D: usize> Neighbours<D> {
         let c = self.centres[i];
         let around = self.cells.around(&self.cell(i));
         let mut len = 0;
-        for &cell in around.as_slice() {
-            for j in self.cells.members(cell) {
+        self.cells.for_each_member_side_by_side(
+            around.as_slice(),
+            #[inline(always)]
+            |j| {
                 if len == found.len() {
                     found.resize(2 * len + 8, 0);
                 }
                 found[len] = j;
                 len += ((j as usize != i) & (self.apart2(&c, &self.centres[j as usize]) < self.range2)) as usize;
-            }
-        }
+            },
+        );
         found.truncate(len);
         self.scratch = found;
     }
@@ -382,11 +384,13 @@ impl<const D: usize> Neighbours<D> {
             self.cells.shift(i, axis, up);
             return;
         }
-        // The new neighbours first, then leave every old neighbour's list and join every new
-        // one's (neither changes what the scan reads): the scan's walk of the cells gives
-        // the old neighbours' rows, asked for before the event (`Timing::leaving`), time to
-        // arrive. A row both old and new is left before it is joined, as in either order of
-        // the two steps.
+        // The new neighbours first, then leave the lists of the old neighbours no longer in
+        // range and join those of the new ones not in range before (neither changes what the
+        // scan reads): the scan's walk of the cells gives the old neighbours' rows, asked for
+        // before the event (`Timing::leaving`), time to arrive. A particle leaves its skin
+        // having moved half a skin, and most of its neighbours stay: their rows are left
+        // alone (leaving and joining again would only move `i` to the row's end, and which
+        // entry of a row holds whom changes no search).
         let mut old = [List::EMPTY; lists::MAX_ROWS];
         old[..Self::ROWS].copy_from_slice(self.rows(i));
         let old = Rows(&old[..Self::ROWS]);
@@ -399,23 +403,36 @@ impl<const D: usize> Neighbours<D> {
         }
         self.centres[i] = centre;
         self.scan(i);
-        // A crowded particle does not know its old neighbours: everyone in the cells around
-        // its old centre is asked, and `drop` ignores those without it.
+        let found = std::mem::take(&mut self.scratch);
         if old.crowded() {
+            // A crowded particle does not know its old neighbours: everyone in the cells
+            // around its old centre is asked, and `drop` ignores those without it.
             let rows = Self::ROWS;
             for j in self.cells.neighbours(from) {
                 if j != i {
                     lists::drop(&mut self.lists[j * rows..(j + 1) * rows], i as u32);
                 }
             }
-        } else {
-            for j in old.members() {
-                lists::drop(self.rows_mut(j), i as u32);
+            for &j in &found {
+                lists::add(self.rows_mut(j as usize), i as u32);
             }
-        }
-        let found = std::mem::take(&mut self.scratch);
-        for &j in &found {
-            lists::add(self.rows_mut(j as usize), i as u32);
+        } else {
+            // Membership in a row-sized block of entries is one vector compare; a particle
+            // crowded from now on has more new neighbours than that, compared one by one.
+            let new = lists::block(found.iter().copied());
+            for j in old.members() {
+                let stays =
+                    if found.len() <= new.len() { new.contains(&(j as u32)) } else { found.contains(&(j as u32)) };
+                if !stays {
+                    lists::drop(self.rows_mut(j), i as u32);
+                }
+            }
+            let before = lists::block(old.entries());
+            for &j in &found {
+                if !before.contains(&j) {
+                    lists::add(self.rows_mut(j as usize), i as u32);
+                }
+            }
         }
         lists::fill(self.rows_mut(i), &found);
         self.scratch = found;
@@ -639,6 +656,55 @@ mod tests {
             }
         }
         assert!(checked > 2500, "{checked}");
+    }
+
+    /// Lists stay what they are defined to be through thousands of rebuilds of spheres that
+    /// jump anywhere (a rebuild leaves and joins only the rows that change, and must still
+    /// leave every row it is no longer in range of and join every new one), in a box dense
+    /// enough that some particles have more neighbours than their rows hold (crowded) and
+    /// come back from it.
+    #[test]
+    fn rebuilds_keep_the_lists_true_with_crowds() {
+        let n = 400;
+        let l = 9.0;
+        let sim_box = SimBox { lengths: SVector::from([l; 3]), boundary: [Boundary::Periodic; 3] };
+        let mut rng = Xoshiro256PlusPlus::seed_from_u64(11);
+        let anywhere = |rng: &mut Xoshiro256PlusPlus| SVector::from(std::array::from_fn(|_| rng.random_range(0.0..l)));
+        let particles: Vec<Particle<3>> = (0..n)
+            .map(|_| Particle {
+                position: anywhere(&mut rng),
+                velocity: SVector::zeros(),
+                time: 0.0,
+                radius: 0.5,
+                mass: 1.0,
+                species: 0,
+                events: 0,
+            })
+            .collect();
+        let mut neighbours =
+            Neighbours::new(&sim_box, 1.0, &particles, 0.0, true, Neighbourhood::Lists, &crate::engine::arrays::Plain);
+        assert!(neighbours.listed());
+        neighbours.check();
+        let (mut most_crowded, mut least_crowded) = (0, n);
+        for round in 0..3000 {
+            let i = rng.random_range(0..n);
+            // Mostly a short step (most neighbours stay), sometimes a jump anywhere.
+            let position = if round % 5 == 0 {
+                anywhere(&mut rng)
+            } else {
+                neighbours.centres[i] + SVector::from(std::array::from_fn(|_| rng.random_range(-0.4..0.4)))
+            };
+            let p = Particle { position, ..particles[i].clone() };
+            neighbours.rebuild(i, &p, 0.0);
+            if round % 50 == 0 {
+                neighbours.check();
+                most_crowded = most_crowded.max(neighbours.crowded());
+                least_crowded = least_crowded.min(neighbours.crowded());
+            }
+        }
+        neighbours.check();
+        assert!(most_crowded > 0, "no particle was ever crowded");
+        assert!(least_crowded < most_crowded, "crowds never changed: {least_crowded}");
     }
 
     /// `Auto` keeps lists for dense equal disks and spheres and for a dense 1 : 1.4 mixture,

@@ -86,6 +86,18 @@ pub(super) fn old_rows<const D: usize>(at: &Reading<'_, D>, a: usize) {
     }
 }
 
+/// The records of the particles `near`: the line the search reads (position, velocity,
+/// time and radius), and the one holding the event count, which a candidate's event records
+/// (the same line for disks, the next for spheres).
+#[inline(always)]
+pub(super) fn records<const D: usize>(at: &Reading<'_, D>, near: &[u32]) {
+    for &j in near {
+        let q = &at.particles[j as usize];
+        prefetch(q);
+        prefetch(&q.events);
+    }
+}
+
 /// Stage one (see the module docs): the guess of the next event after `a` and `b`'s, with
 /// its record, pending event and row on their way.
 pub(super) fn first_stage<const D: usize>(at: &Reading<'_, D>, a: usize, b: usize) -> usize {

@@ -4,10 +4,11 @@
 //! starts. Nothing here changes a result: with every part of it on or off, the events are the
 //! same bit for bit (tested), only the time differs.
 //!
-//! The engine meets it through [`Timing`] alone, at five points: the store its structures
-//! build their large arrays in ([`Timing::store`]) and four places
+//! The engine meets it through [`Timing`] alone, at six points: the store its structures
+//! build their large arrays in ([`Timing::store`]) and five places
 //! in a step — before an event is resolved
-//! ([`Timing::begin`]; [`Timing::leaving`] too when a particle leaves its skin), between the
+//! ([`Timing::begin`]; [`Timing::leaving`] too when a particle leaves its skin), before a
+//! search among a particle's neighbours ([`Timing::searching`]), between the
 //! two predictions that follow a collision ([`Timing::middle`]) and after them
 //! ([`Timing::end`]). It reads the engine's structures
 //! through [`Reading`] and never writes them; the structures expose where their data lives,
@@ -113,6 +114,19 @@ impl Timing {
     pub(crate) fn leaving<const D: usize>(&self, at: &Reading<'_, D>, a: usize) {
         if !self.lookahead {
             lookahead::old_rows(at, a);
+        }
+    }
+
+    /// Before a search among the neighbours `near` (gathered from a list or the cells):
+    /// without the lookahead, their records. The search reads them a chunk of
+    /// [`LANES`](crate::engine::search::LANES) at a time, each chunk a long chain of
+    /// arithmetic, so that the loads of one chunk would wait for the chain before them; asked
+    /// for first, they arrive while the first chunk is computed. (With the lookahead, stage
+    /// two of the step before has asked for them.)
+    #[inline(always)]
+    pub(crate) fn searching<const D: usize>(&self, at: &Reading<'_, D>, near: &[u32]) {
+        if !self.lookahead {
+            lookahead::records(at, near);
         }
     }
 
