@@ -506,21 +506,30 @@ impl<const D: usize> Neighbours<D> {
     }
 
     /// Writes particle `i`'s neighbours but `skip` into `out` and returns how many: its
-    /// list, copied without branches — or, if it is crowded, the members of the cells around
-    /// its centre (`None` if they do not fit).
+    /// list — or, if it is crowded, the members of the cells around its centre (`None` if
+    /// they do not fit).
+    ///
+    /// The list is copied whole (its rows are packed: members, then `NONE`), its members
+    /// counted and `skip` found by vector compares, and `skip`, if there, replaced by the last
+    /// member (which entry holds whom changes no search). Written entry by entry, each at
+    /// the count so far, the copy was a chain of sixteen dependent steps.
     #[inline]
     pub fn gather(&self, i: usize, skip: usize, out: &mut [u32]) -> Option<usize> {
         if !self.listed || self.is_crowded(i) {
             return self.gather_cells(i, skip, out);
         }
-        // Row by row (one in 2D, two in 3D: the loops unroll), without branches.
-        let mut len = 0;
+        let (mut len, mut at) = (0, usize::MAX);
         for r in 0..Self::ROWS {
             let row = self.lists[i * Self::ROWS + r].entries();
+            out[r * lists::CAPACITY..(r + 1) * lists::CAPACITY].copy_from_slice(row);
             for (k, &j) in row.iter().enumerate() {
-                out[len.min(r * lists::CAPACITY + k)] = j;
-                len += ((j != NONE) & (j as usize != skip)) as usize;
+                len += (j != NONE) as usize;
+                at = if j as usize == skip { r * lists::CAPACITY + k } else { at };
             }
+        }
+        if at != usize::MAX {
+            len -= 1;
+            out[at] = out[len];
         }
         Some(len)
     }
