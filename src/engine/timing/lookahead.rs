@@ -6,10 +6,12 @@
 //! always, and a wrong guess costs only time — and its data is asked for in three stages, each
 //! a few hundred nanoseconds ahead of its use, so that no stage waits for the one before:
 //!
-//! 1. before the collision is resolved: the next owner's record, pending event, and list and
-//!    centre (or cell coordinates);
-//! 2. between the two predictions that follow: the records on its list (or the heads of the
-//!    cells around it), its partner's record, list and centre (or cell coordinates), and the
+//! 1. before the collision is resolved: the next owner's record (both lines of a sphere's:
+//!    the second holds the event count), pending event, and list and centre (or cell
+//!    coordinates);
+//! 2. between the two predictions that follow: the first lines of the records on its list
+//!    (or the heads of the cells around it), its partner's whole record (the next step first reads its event
+//!    count, to tell whether the event is live), list and centre (or cell coordinates), and the
 //!    lowest levels of both queue paths — or, when its event is leaving its skin, the rows
 //!    of its old neighbours and the heads of the cells around its new centre;
 //! 3. after the predictions, when those have arrived: the records on the partner's list (or
@@ -86,15 +88,26 @@ pub(super) fn old_rows<const D: usize>(at: &Reading<'_, D>, a: usize) {
     }
 }
 
+/// Particle `i`'s whole record: the line the motion and the search read, and the one holding
+/// the event count — which the next step reads first (whether the pair's event is still
+/// live) and the resolution writes (the next line for spheres; the same line for disks,
+/// asked for once).
+#[inline(always)]
+fn record<const D: usize>(at: &Reading<'_, D>, i: usize) {
+    let p = &at.particles[i];
+    prefetch(p);
+    if size_of::<crate::engine::geometry::Particle<D>>() > 64 {
+        prefetch(&p.events);
+    }
+}
+
 /// The records of the particles `near`: the line the search reads (position, velocity,
 /// time and radius), and the one holding the event count, which a candidate's event records
 /// (the same line for disks, the next for spheres).
 #[inline(always)]
 pub(super) fn records<const D: usize>(at: &Reading<'_, D>, near: &[u32]) {
     for &j in near {
-        let q = &at.particles[j as usize];
-        prefetch(q);
-        prefetch(&q.events);
+        record(at, j as usize);
     }
 }
 
@@ -102,7 +115,7 @@ pub(super) fn records<const D: usize>(at: &Reading<'_, D>, near: &[u32]) {
 /// its record, pending event and row on their way.
 pub(super) fn first_stage<const D: usize>(at: &Reading<'_, D>, a: usize, b: usize) -> usize {
     let next = at.queue.guess_next(a, b);
-    prefetch(&at.particles[next]);
+    record(at, next);
     at.queue.footprint(next, Reads::Slot, prefetch_address);
     row(at, next);
     next
@@ -131,7 +144,7 @@ pub(super) fn second_stage<const D: usize>(at: &Reading<'_, D>, next: usize) -> 
     match event.kind {
         EventKind::Pair { partner, .. } => {
             let partner = partner as usize;
-            prefetch(&at.particles[partner]);
+            record(at, partner);
             row(at, partner);
             at.queue.footprint(partner, Reads::Path, prefetch_address);
             ahead.partner = Some(partner);
