@@ -90,6 +90,19 @@ impl<const D: usize> Side<D> {
         bracket_neighbours(particles, i, js, n_near - start, sim_box, now, lo, hi, balls)
     }
 
+    /// The lanes among the first `n_near` whose contact can come no later than `bound` (a
+    /// bit each): the candidates [`settle`](Self::settle) times.
+    #[inline(always)]
+    fn marked(&self, n_near: usize, bound: f64) -> u64 {
+        const { assert!(NEAR <= 64) };
+        let lanes = n_near.div_ceil(LANES) * LANES;
+        let mut marked = 0u64;
+        for (k, &lo) in self.lo[..lanes].iter().enumerate() {
+            marked |= ((lo <= bound) as u64) << k;
+        }
+        marked & if n_near < 64 { (1u64 << n_near) - 1 } else { u64::MAX }
+    }
+
     /// Pass 2: the candidates whose bracket reaches down to `bound`, offered to `best` (the
     /// event of `owner`). Which lanes are candidates is a coin toss for the branch predictor:
     /// they are marked without branches first, one bit each, and the bits are visited lowest
@@ -108,14 +121,8 @@ impl<const D: usize> Side<D> {
         bound: f64,
         best: &mut Event,
     ) {
-        let lanes = n_near.div_ceil(LANES) * LANES;
         let Side { lo, hi, lanes: balls } = self;
-        const { assert!(NEAR <= 64) };
-        let mut marked = 0u64;
-        for (k, &lo) in lo[..lanes].iter().enumerate() {
-            marked |= ((lo <= bound) as u64) << k;
-        }
-        marked &= if n_near < 64 { (1u64 << n_near) - 1 } else { u64::MAX };
+        let mut marked = self.marked(n_near, bound);
         while marked != 0 {
             let k = marked.trailing_zeros() as usize;
             marked &= marked - 1;
@@ -228,6 +235,26 @@ impl<const D: usize> Search<D> {
             }
         }
         [bound_a, bound_b]
+    }
+
+    /// Calls `f` with the candidates of both sides after [`bracket_both`](Self::bracket_both)
+    /// (with its arguments and bounds): the neighbours [`settle_both`](Self::settle_both) will
+    /// make an event with.
+    #[inline(always)]
+    pub(crate) fn candidates(
+        &self,
+        near: [&[u32; NEAR]; 2],
+        gathered: [usize; 2],
+        bounds: [f64; 2],
+        mut f: impl FnMut(usize),
+    ) {
+        for s in 0..2 {
+            let mut marked = self.sides[s].marked(gathered[s], bounds[s]);
+            while marked != 0 {
+                f(near[s][marked.trailing_zeros() as usize] as usize);
+                marked &= marked - 1;
+            }
+        }
     }
 
     /// Pass 2 after [`bracket_both`](Self::bracket_both), with its arguments and bounds: the

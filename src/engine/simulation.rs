@@ -849,6 +849,7 @@ impl<const D: usize> Simulation<D> {
             gathered,
             [&best_i, &best_j],
         );
+        self.timing.candidates(&self.reading(), &self.search, near, gathered, bounds);
         let ahead = self.timing.middle(&self.reading(), guess);
         self.search.settle_both(&self.particles, self.time, [i, j], near, gathered, bounds, [&mut best_i, &mut best_j]);
         self.queue.set(i, best_i);

@@ -17,6 +17,12 @@
 //! 3. after the predictions, when those have arrived: the records on the partner's list (or
 //!    the first members of the cells around the owner, or around the new centre).
 //!
+//! Within the step, between a collision's brackets and its candidates' exact times, the line
+//! holding each candidate's event count is asked for too
+//! ([`Timing::candidates`](super::Timing::candidates)): a sphere's record spans two lines,
+//! and asking for every neighbour's second line in stage two measured slower than asking
+//! for the one or two a search turns out to need.
+//!
 //! The stages pay only once the engine's state has left the level-2 cache ([`pays`]): finding
 //! the next event and issuing the hints costs instructions that only misses of that cache
 //! repay.

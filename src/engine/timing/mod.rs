@@ -28,6 +28,7 @@ use super::geometry::Particle;
 use super::neighbours::Neighbours;
 use super::params::{EngineParams, Switch};
 use super::queue::EventQueue;
+use super::search::{NEAR, Search};
 
 /// The store of [`Timing::store`].
 #[derive(Clone, Copy, Debug)]
@@ -127,6 +128,25 @@ impl Timing {
     pub(crate) fn searching<const D: usize>(&self, at: &Reading<'_, D>, near: &[u32]) {
         if !self.lookahead {
             lookahead::records(at, near);
+        }
+    }
+
+    /// After the brackets of a collision's two partners, before their candidates are timed:
+    /// with the lookahead, the line of each candidate's record that holds its event count,
+    /// which the candidate's event records (stage two of the step before asked for the first
+    /// line of every neighbour's record only; a sphere's count is on the second). Asked for
+    /// here, it arrives while stage two runs.
+    #[inline(always)]
+    pub(crate) fn candidates<const D: usize>(
+        &self,
+        at: &Reading<'_, D>,
+        search: &Search<D>,
+        near: [&[u32; NEAR]; 2],
+        gathered: [usize; 2],
+        bounds: [f64; 2],
+    ) {
+        if self.lookahead && size_of::<Particle<D>>() > 64 {
+            search.candidates(near, gathered, bounds, |j| prefetch(&at.particles[j].events));
         }
     }
 
