@@ -701,7 +701,7 @@ impl<const D: usize> Simulation<D> {
             let (Some(a), b) = next.involved(owner) else { unreachable!("an event of a particle") };
             let guess = self.timing.begin(&self.reading(), a, b);
             if next.kind == EventKind::Rebuild {
-                self.timing.leaving(&self.reading(), a);
+                self.timing.leaving(&self.reading(), a, next.time);
             }
             let radii = self.radii();
             let outcome = sources::resolve(

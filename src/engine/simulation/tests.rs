@@ -271,8 +271,9 @@ fn lookahead_changes_nothing() {
 }
 
 /// Spheres too (whose records span two lines, so the lookahead also asks for each
-/// candidate's event count between the brackets and the exact times): with the lookahead
-/// forced on, a fluid with lists runs through the same events bit for bit.
+/// candidate's event count between the brackets and the exact times, and before a rebuild
+/// walks the cells its scan will read): with the lookahead forced on, a fluid with lists
+/// runs through the same events bit for bit, rebuilds among them.
 #[test]
 fn lookahead_changes_nothing_for_spheres() {
     let (particles, sim_box) = crate::bench::state::initial_state::<3>(500, 0.45, 3).expect("a state");
@@ -285,6 +286,7 @@ fn lookahead_changes_nothing_for_spheres() {
         assert_eq!(plain.step(), ahead.step());
     }
     assert!(plain.counts().pair > 20_000);
+    assert!(plain.counts().rebuild > 1_000, "{:?}", plain.counts());
     assert_eq!(plain.particles(), ahead.particles());
     assert_eq!(plain.time().to_bits(), ahead.time().to_bits());
     assert_eq!(plain.counts(), ahead.counts());

@@ -10,10 +10,11 @@
 //!    the second holds the event count), pending event, and list and centre (or cell
 //!    coordinates);
 //! 2. between the two predictions that follow: the first lines of the records on its list
-//!    (or the heads of the cells around it), its partner's whole record (the next step first reads its event
-//!    count, to tell whether the event is live), list and centre (or cell coordinates), and the
-//!    lowest levels of both queue paths — or, when its event is leaving its skin, the rows
-//!    of its old neighbours and the heads of the cells around its new centre;
+//!    (or the heads of the cells around it), its partner's whole record (the next step first
+//!    reads its event count, to tell whether the event is live), list and centre (or cell
+//!    coordinates), and the lowest levels of both queue paths — or, when its event is leaving
+//!    its skin, the rows of its old neighbours and the heads of the cells around its new
+//!    centre;
 //! 3. after the predictions, when those have arrived: the records on the partner's list (or
 //!    the first members of the cells around the owner, or around the new centre).
 //!
@@ -23,6 +24,12 @@
 //! and asking for every neighbour's second line in stage two measured slower than asking
 //! for the one or two a search turns out to need.
 //!
+//! When the event being processed is a particle leaving its skin, the centres of everyone in
+//! the cells around its new centre are asked for before the rebuild ([`scanned`]): stage
+//! three has brought only each cell's first member, and the rebuild's scan, which computes a
+//! distance per member as it walks the cells, keeps too few of the others' loads in flight
+//! at once (at large N, waiting on them was most of its time).
+//!
 //! The stages pay only once the engine's state has left the level-2 cache ([`pays`]): finding
 //! the next event and issuing the hints costs instructions that only misses of that cache
 //! repay.
@@ -30,6 +37,7 @@
 use super::Reading;
 use super::cache::level2_bytes;
 use super::prefetch::{prefetch, prefetch_address};
+use crate::engine::geometry::Particle;
 use crate::engine::neighbours::cells::Around;
 use crate::engine::queue::Reads;
 use crate::engine::sources::EventKind;
@@ -94,16 +102,42 @@ pub(super) fn old_rows<const D: usize>(at: &Reading<'_, D>, a: usize) {
     }
 }
 
+/// With the lookahead, before particle `a` leaves its skin at `t`: the centres of everyone in
+/// the cells around its new centre, which the rebuild's scan measures against. The scan
+/// walks the cells' lists and computes a distance per member, so few of its loads are in
+/// flight at once; walked here with nothing but the hints, they all are.
+#[inline(always)]
+pub(super) fn scanned<const D: usize>(at: &Reading<'_, D>, a: usize, t: f64) {
+    if at.neighbours.row(a).is_none() {
+        return;
+    }
+    let cells = at.neighbours.cells();
+    let around = cells.around(&cells.locate(&at.particles[a].position_at(t)));
+    let centres = at.neighbours.centres();
+    cells.for_each_member_side_by_side(around.as_slice(), |j| prefetch(&centres[j as usize]));
+}
+
 /// Particle `i`'s whole record: the line the motion and the search read, and the one holding
 /// the event count — which the next step reads first (whether the pair's event is still
 /// live) and the resolution writes (the next line for spheres; the same line for disks,
 /// asked for once).
 #[inline(always)]
 fn record<const D: usize>(at: &Reading<'_, D>, i: usize) {
-    let p = &at.particles[i];
-    prefetch(p);
-    if size_of::<crate::engine::geometry::Particle<D>>() > 64 {
-        prefetch(&p.events);
+    prefetch(&at.particles[i]);
+    event_count(at, i);
+}
+
+/// Whether a particle's record spans two cache lines, its event count on the second (spheres).
+pub(super) const fn two_lines<const D: usize>() -> bool {
+    size_of::<Particle<D>>() > 64
+}
+
+/// The second line of particle `i`'s record, which holds its event count (nothing where the
+/// record is one line).
+#[inline(always)]
+pub(super) fn event_count<const D: usize>(at: &Reading<'_, D>, i: usize) {
+    if two_lines::<D>() {
+        prefetch(&at.particles[i].events);
     }
 }
 

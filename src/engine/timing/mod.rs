@@ -109,11 +109,15 @@ impl Timing {
         }
     }
 
-    /// Before particle `a` leaves its skin (a rebuild): without the lookahead, the rows of
-    /// its old neighbours (with it, stage two of the step before has asked for them).
+    /// Before particle `a` leaves its skin at `t` (a rebuild): with the lookahead, the centres
+    /// its rebuild's scan reads (stage two of the step before has asked for the rows of its
+    /// old neighbours); without it, those rows (at small N the centres are in cache, and
+    /// walking the cells twice measured slower).
     #[inline(always)]
-    pub(crate) fn leaving<const D: usize>(&self, at: &Reading<'_, D>, a: usize) {
-        if !self.lookahead {
+    pub(crate) fn leaving<const D: usize>(&self, at: &Reading<'_, D>, a: usize, t: f64) {
+        if self.lookahead {
+            lookahead::scanned(at, a, t);
+        } else {
             lookahead::old_rows(at, a);
         }
     }
@@ -145,8 +149,8 @@ impl Timing {
         gathered: [usize; 2],
         bounds: [f64; 2],
     ) {
-        if self.lookahead && size_of::<Particle<D>>() > 64 {
-            search.candidates(near, gathered, bounds, |j| prefetch(&at.particles[j].events));
+        if self.lookahead && lookahead::two_lines::<D>() {
+            search.candidates(near, gathered, bounds, |j| lookahead::event_count(at, j));
         }
     }
 
