@@ -52,21 +52,27 @@ fn batch_and_scalar_searches_give_identical_events() {
         let batch = system(40, big, neighbourhood);
         assert_eq!(batch.lists(), neighbourhood == Neighbourhood::Lists);
         assert!(batch.search.batch);
-        let mut scalar = batch.clone();
-        scalar.search.batch = false;
-        // Re-predict everything one pair at a time, as if that had been on from the start.
-        for i in 0..scalar.particles.len() {
-            scalar.predict(i);
-        }
-        let (mut batch, mut scalar) = (batch, scalar);
-        for _ in 0..20_000 {
-            let (a, b) = (batch.step(), scalar.step());
-            assert_eq!(a, b);
-            assert_eq!(batch.time().to_bits(), scalar.time().to_bits());
-        }
-        assert_eq!(batch.particles(), scalar.particles());
+        let batch = runs_as_the_scalar_search(batch, 20_000);
         assert!(batch.counts().pair > 10_000, "{:?}", batch.counts());
     }
+}
+
+/// Runs `batch` (a simulation with the batch search) for `steps` steps beside a copy that
+/// searches one pair at a time, every particle predicted again that way as if it had been
+/// on from the start, and asserts the same events at the same times and the same particles
+/// at the end, bit for bit. Returns the batch run, for its counts.
+fn runs_as_the_scalar_search<const D: usize>(mut batch: Simulation<D>, steps: usize) -> Simulation<D> {
+    let mut scalar = batch.clone();
+    scalar.search.batch = false;
+    for i in 0..scalar.particles.len() {
+        scalar.predict(i);
+    }
+    for _ in 0..steps {
+        assert_eq!(batch.step(), scalar.step());
+        assert_eq!(batch.time().to_bits(), scalar.time().to_bits());
+    }
+    assert_eq!(batch.particles(), scalar.particles());
+    batch
 }
 
 /// Spheres, and a mixture: the batch search (both partners of a collision side by side,
@@ -81,17 +87,7 @@ fn batch_and_scalar_searches_give_identical_events_for_spheres() {
     }
     let batch = Simulation::with_neighbourhood(particles, sim_box, Neighbourhood::Lists).expect("a simulation");
     assert!(batch.search.batch && batch.neighbours.listed());
-    let mut scalar = batch.clone();
-    scalar.search.batch = false;
-    for i in 0..scalar.particles.len() {
-        scalar.predict(i);
-    }
-    let (mut batch, mut scalar) = (batch, scalar);
-    for _ in 0..30_000 {
-        assert_eq!(batch.step(), scalar.step());
-        assert_eq!(batch.time().to_bits(), scalar.time().to_bits());
-    }
-    assert_eq!(batch.particles(), scalar.particles());
+    let batch = runs_as_the_scalar_search(batch, 30_000);
     assert!(batch.counts().pair > 20_000, "{:?}", batch.counts());
 }
 
