@@ -297,6 +297,32 @@ fn within_contract<const D: usize>(families: Vec<(&'static str, BoxedStrategy<(B
                             prop_assert_eq!((lo[lane].to_bits(), hi[lane].to_bits()), (l.to_bits(), h.to_bits()));
                         }
                     }
+                    // The same lanes moved to the frame of the first ball (the second's
+                    // position rounded to the difference): `contact_brackets_from_origin`,
+                    // which never reads the first positions (NaN here), gives the brackets
+                    // `contact_brackets` gives with them at +0, bit for bit.
+                    let mut origin = BallLanes::<D, 8>::default();
+                    let mut ignored = BallLanes::<D, 8>::default();
+                    for lane in 0..8 {
+                        let (x, y) = if lane % 2 == 0 { (&p, &q) } else { (&q, &p) };
+                        let moved = Ball { position: core::array::from_fn(|i| y.position[i] - x.position[i]), ..*y };
+                        second.set(lane, &moved);
+                        origin.set(lane, &Ball { position: [0.0; D], ..*x });
+                        ignored.set(lane, &Ball { position: [f64::NAN; D], ..*x });
+                    }
+                    let (mut lo0, mut hi0) = ([0.0; 8], [0.0; 8]);
+                    quadratic::contact_brackets(&origin, &second, &mut lo, &mut hi);
+                    quadratic::contact_brackets_from_origin(&ignored, &second, &mut lo0, &mut hi0);
+                    for lane in 0..8 {
+                        prop_assert_eq!(
+                            (lo[lane].to_bits(), hi[lane].to_bits()),
+                            (lo0[lane].to_bits(), hi0[lane].to_bits()),
+                            "{:?} {:?}: lane {}",
+                            p,
+                            q,
+                            lane
+                        );
+                    }
                 }
                 if k == 3 && matches!(got, Contact::At(_)) {
                     *hits.borrow_mut() += 1;

@@ -14,7 +14,7 @@
 //! advanced.
 //!
 //! The engine evaluates this prediction for a particle against all its neighbours at once
-//! through its batch search (`engine/search.rs`), which gives the same times bit for bit;
+//! through its batch search (`engine/search/`), which gives the same times bit for bit;
 //! the reference engine calls [`predict`] for every pair.
 
 use crate::engine::collision::{Body, Impulse, Restitution, resolve_growing_pair};

@@ -1,8 +1,9 @@
 //! The cache hint: ask for the line holding a value before it is needed.
 //!
-//! One of the crate's two `unsafe` blocks: `_mm_prefetch` takes a raw pointer, although a
-//! prefetch cannot fault, reads nothing into the program and writes nothing — results are the
-//! same bit for bit with or without it.
+//! One of the crate's three `unsafe` blocks (with the huge-page request and the search's
+//! vector read of records): `_mm_prefetch` takes a raw pointer, although a prefetch cannot
+//! fault, reads nothing into the program and writes nothing — results are the same bit for
+//! bit with or without it.
 
 /// Starts loading the cache line at `address` into all cache levels, without waiting.
 #[allow(unsafe_code)]

@@ -18,16 +18,22 @@
 //! the core busy where one left it waiting. The rare exact root stays out of line
 //! ([`Lanes::predict`]), so that the code the search runs every time stays compact.
 //!
+//! The neighbours' records are read eight at a time as whole cache lines where AVX-512 is
+//! built in ([`lines`]): a chunk is bound by the vector operations it issues, and the
+//! field-by-field gather was a hundred of them.
+//!
 //! Short periodic axes (several images of one pair) and crowds of more than [`NEAR`]
 //! neighbours take the scalar search, one pair at a time with a shrinking horizon; same
 //! events.
+
+mod lines;
 
 use super::geometry::{Boundary, Particle, SimBox, image_count, image_count_by_comparison};
 use super::motion::{self, Radii};
 use super::neighbours::Neighbours;
 use super::sources::pair::{self, PairBracket};
 use super::sources::{Event, EventKind};
-use quadratic::{BallLanes, contact_brackets, contact_time_unchecked, narrow_contact};
+use quadratic::{BallLanes, contact_brackets_from_origin, contact_time_unchecked, narrow_contact};
 
 /// Pairs bracketed at once: one AVX-512 register of f64 (two AVX2).
 pub const LANES: usize = 8;
@@ -343,7 +349,7 @@ fn scalar<const D: usize>(
 
 /// [`pair::bracket`] for particle `i` against the neighbours `js[..len]` (up to [`LANES`])
 /// at once, when no axis is short, through the branch-free batch kernel
-/// [`contact_brackets`]. On return, for each `k < len`: if [`pair::predict`] gives `Some(t)`
+/// [`contact_brackets_from_origin`]. On return, for each `k < len`: if [`pair::predict`] gives `Some(t)`
 /// for the pair, then `lo[k] ≤ max(t, now) ≤ hi[k]` (absolute times); `lo[k] = +∞` when it
 /// gives `None` (or a time that itself overflows to `+∞`, so a caller searching up to an
 /// infinite bound still asks [`pair::predict`]). Lanes `k ≥ len` give `[+∞, +∞]` whatever
@@ -370,20 +376,12 @@ pub fn bracket_neighbours<const D: usize>(
     let p = &particles[i];
     let last = particles.len() - 1;
     // Gather: the neighbours' states, one lane each (unused lanes pair `i` with itself).
-    let mut qx = [[0.0; LANES]; D];
-    let mut qv = [[0.0; LANES]; D];
-    let mut qt = [0.0; LANES];
-    let mut qr = [0.0; LANES];
-    for k in 0..LANES {
-        let j = std::hint::select_unpredictable(k < len, js[k] as usize, i).min(last);
-        let q = &particles[j];
-        for a in 0..D {
-            qx[a][k] = q.position[a];
-            qv[a][k] = q.velocity[a];
-        }
-        qt[k] = q.time;
-        qr[k] = q.radius;
-    }
+    let records: [&Particle<D>; LANES] =
+        core::array::from_fn(|k| &particles[std::hint::select_unpredictable(k < len, js[k] as usize, i).min(last)]);
+    let fields = lines::first_lines(&records);
+    let qx: [[f64; LANES]; D] = core::array::from_fn(|a| fields[a]);
+    let qv: [[f64; LANES]; D] = core::array::from_fn(|a| fields[D + a]);
+    let (qt, qr) = (fields[2 * D], fields[2 * D + 1]);
     // The balls, as `pair::predict` forms them: `i` at the origin (the same for every lane)
     // and the neighbour at its separation at `t0`, the later update time, from `i` to the
     // image nearest to `i` at `now`.
@@ -425,7 +423,7 @@ pub fn bracket_neighbours<const D: usize>(
             }
         }
     }
-    contact_brackets(first, second, lo, hi);
+    contact_brackets_from_origin(first, second, lo, hi);
     // Absolute times, no earlier than `now`, and +∞ past the neighbours: selects on values
     // computed in every lane, which compile to vector compares and blends (a branch on
     // `k < len` per lane mispredicts in the last chunk, whose length varies).
