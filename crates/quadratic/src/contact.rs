@@ -1345,14 +1345,6 @@ mod tests {
         assert!(matches!(contact_time(&p, &q), Err(ContactError::NegativeRadius { ball: 2, .. })));
     }
 
-    /// The widening of [`bracket_ends`] against its derivation: with exact values (zero
-    /// bounds), every bracket must hold the band `t·(1 ∓ 2u)` — one ulp either side of the
-    /// exact root `t`, where the kernel's time may lie — for `b`, `c`, `D` spread over twelve
-    /// decades and `D` down to 10⁻⁸·b² (glancing). The root is computed in double-double
-    /// (relative error ~2⁻¹⁰³, far inside the margins). With 8u this must hold everywhere;
-    /// with 5u it must fail somewhere (measured: about 400 of the 200 000 cases; 900 with 4u,
-    /// none from 6u on — the ends' roundings reach past 3u, their bound being 4.5u plus the
-    /// widening's own), so the test tells a widening too small from a sufficient one.
     /// The batch's range check (`in_range`) gives the verdict of the per-axis form the filter
     /// is written in, on every combination of special values in two dimensions (NaN, ±∞,
     /// both sides of 2^±150, zeros of both signs, ordinary numbers).
@@ -1408,6 +1400,14 @@ mod tests {
         assert!(accepted > checked / 50 && accepted < checked / 2, "{accepted} of {checked}");
     }
 
+    /// The widening of [`bracket_ends`] against its derivation: with exact values (zero
+    /// bounds), every bracket must hold the band `t·(1 ∓ 2u)` — one ulp either side of the
+    /// exact root `t`, where the kernel's time may lie — for `b`, `c`, `D` spread over twelve
+    /// decades and `D` down to 10⁻⁸·b² (glancing). The root is computed in double-double
+    /// (relative error ~2⁻¹⁰³, far inside the margins). With 8u this must hold everywhere;
+    /// with 5u it must fail somewhere (measured: about 400 of the 200 000 cases; 900 with 4u,
+    /// none from 6u on — the ends' roundings reach past 3u, their bound being 4.5u plus the
+    /// widening's own), so the test tells a widening too small from a sufficient one.
     #[test]
     fn bracket_ends_hold_the_one_ulp_band() {
         let mut unit = crate::uniform_stream(0x2545_F491_4F6C_DD1Du64);

@@ -2,10 +2,10 @@
 //! bit, as evaluating [`pair::predict`] for every neighbour and taking the earliest in the
 //! total order (checked against that, and against the brute-force reference).
 //!
-//! Two passes. First every neighbour is *bracketed*: the certified f64 filter of the kernel
-//! ([`contact_brackets`]) gives an interval `[lo, hi]` holding the pair's contact time (or
-//! says there is none), [`LANES`] neighbours at a time, branch-free, without any
-//! double-double arithmetic; the bound becomes the smallest upper end (or the particle's
+//! Two passes. First every neighbour is *bracketed*: the certified f64 filter of the kernel,
+//! in the predicted particle's frame ([`contact_brackets_from_origin`]), gives an interval
+//! `[lo, hi]` holding the pair's contact time (or says there is none), [`LANES`] neighbours
+//! at a time, branch-free, without any double-double arithmetic; the bound becomes the smallest upper end (or the particle's
 //! earliest other event). Then only the *candidates* — the neighbours whose lower end
 //! reaches down to the bound, usually one — get their exact time: from the bracket itself
 //! when both ends round to the same absolute time (rounding is monotone, so that is the time
@@ -464,7 +464,9 @@ fn smaller(a: f64, b: f64) -> f64 {
 /// The balls of one chunk of [`bracket_neighbours`]' lanes, and the `t0` of each.
 #[derive(Clone, Copy, Debug, Default)]
 pub struct Lanes<const D: usize> {
-    /// The predicted particle, in every lane.
+    /// The predicted particle, in every lane, at the origin: its positions stay `+0.0` (the
+    /// default), which [`contact_brackets_from_origin`] assumes without reading them and
+    /// [`predict`](Self::predict) and [`pinned`](Self::pinned) read.
     pub first: BallLanes<D, LANES>,
     /// The neighbours.
     pub second: BallLanes<D, LANES>,
