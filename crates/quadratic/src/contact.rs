@@ -1430,4 +1430,48 @@ mod tests {
         assert_eq!(misses(WIDEN, &mut unit), 0, "the widening of bracket_ends misses the band");
         assert!(misses(5.0 * U, &mut unit) > 0, "a widening of 5u should miss: the test has no teeth");
     }
+
+    /// The error bounds' side of [`bracket_ends`] (the test above has them all zero): with
+    /// nonzero bounds the bracket must hold every root the box `c ∈ [c̃ ∓ γ]`,
+    /// `−b ∈ [B ∓ β]`, `D ∈ [D̃ ∓ δ]` allows, one ulp either side — that is,
+    /// `(c̃ − γ)/(B + β + √(D̃ + δ))·(1 − 2u)` and `(c̃ + γ)/(B − β + √(D̃ − δ))·(1 + 2u)`, in
+    /// double-double — for `δ/D̃` spread over `(0, 1)` (up to a `D` barely certified) and
+    /// `β/B`, `γ/c` up to a quarter. And it must be no wider than those roots by more than
+    /// the widening and the ends' roundings, `(2·8 + 2·4.5)u` relatively, and 3u for the
+    /// differences' own rounding in the measure (measured: 23u).
+    /// Teeth: a bracket built from `√(D̃ + δ)` on both sides, or from `B` without `β`, fails.
+    #[test]
+    fn bracket_ends_hold_the_box() {
+        let mut unit = crate::uniform_stream(0x9E37_79B9_7F4A_7C15u64);
+        let mut widest = 0.0f64;
+        for _ in 0..200_000 {
+            let big_b = 10f64.powf(12.0 * unit() - 6.0);
+            let c = 10f64.powf(12.0 * unit() - 6.0);
+            let disc = big_b * big_b * 10f64.powf(-8.0 * unit());
+            let bound_b = big_b * 0.25 * 10f64.powf(-14.0 * unit());
+            let bound_c = c * 0.25 * 10f64.powf(-14.0 * unit());
+            let y = if unit() < 0.5 { unit() } else { 10f64.powf(-14.0 * unit()) };
+            let bound_d = disc * y.min(0.999);
+            let (lo, hi) = bracket_ends((-big_b, bound_b), (c, bound_c), (disc, bound_d));
+            let dd = Dd::from_f64;
+            let small = dd(c).add(dd(-bound_c));
+            let large = dd(c).add(dd(bound_c));
+            let root_plus = dd(disc).add(dd(bound_d)).sqrt();
+            let root_minus = dd(disc).add(dd(-bound_d)).sqrt();
+            let t_min = small.div(dd(big_b).add(dd(bound_b)).add(root_plus));
+            let t_max = large.div(dd(big_b).add(dd(-bound_b)).add(root_minus));
+            let below = t_min.mul(dd(1.0 - 2.0 * U));
+            let above = t_max.mul(dd(1.0 + 2.0 * U));
+            assert!(
+                lo - below.hi <= below.lo && hi - above.hi >= above.lo,
+                "b {big_b:e}±{bound_b:e} c {c:e}±{bound_c:e} D {disc:e}±{bound_d:e}: [{lo:e}, {hi:e}] \
+                 does not hold [{:e}, {:e}]",
+                t_min.hi,
+                t_max.hi
+            );
+            let excess = ((hi - lo) - (t_max.hi - t_min.hi)) / (U * t_max.hi);
+            widest = widest.max(excess);
+        }
+        assert!(widest <= 28.0, "a bracket {widest:.1}u wider than its box");
+    }
 }
