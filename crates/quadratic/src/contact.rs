@@ -1124,21 +1124,21 @@ fn filter_disc<const D: usize>(h: &[f64; D], g: &[f64; D], s: f64) -> (f64, f64,
 ///
 /// Both reciprocals come from one division: `p = d̃ ⊗ r̃`, `i = 1 ⊘ p`, then `1/d ≈ r̃ ⊗ i`
 /// (within 5u: `r̃`, `d̃`, `p`, `i` and the product round once each, `d̃` a sum of positive
-/// terms) and `1/r ≈ d̃ ⊗ i` (within 4u). The computed `x̃±` are then within 23u of `x±`
-/// relatively (`z̃` 5u, `ỹ` 10u, the sums and products one each, `1/d` 5u), and
-/// `w± = x̃± ⊗ (1 + 64u)` are above `x±·(1 + W)`; the factors `1 − W − w₋` and
+/// terms) and `1/r ≈ d̃ ⊗ i` (within 4u). The computed `w± = ẽ± ⊗ (1/d ⊗ K)`, `K = 1 + 64u`
+/// (`below` and `above` in the code), are within 24u of `K·x±` relatively (`z̃` 5u, `ỹ` 10u,
+/// the sums and products one each, `1/d` 5u), so above `x±·(1 + W)`; the factors `1 − W − w₋` and
 /// `1 + W + w₊(1 + 2w₊)` (FMAs) stay below `(1 − x₋)(1 − W)` and above
 /// `(1 + x₊ + 2x₊²)(1 + W)` but for their final rounding. Each end is then a numerator (one
 /// rounding), `1/d` (5u), the factor (one) and two products: 9u in all, and the time the
 /// kernel returns is within one ulp (at most 2u relatively) of `t`, so [`WIDEN`]` = W = 12u`
 /// covers the 11u with room for the second-order terms; ∓MIN_POSITIVE covers underflow of the
-/// ends (and of `x̃±`, whose absolute error is then far below the factors' rounding). When
-/// `x̃₊ > 0.49` (`x₊` might exceed ½: a glancing pair whose `D̃` is barely certified) the
+/// ends (and of `w±`, whose absolute error is then far below the factors' rounding). When
+/// `w₊ > 0.49` (`x₊` might exceed ½: a glancing pair whose `D̃` is barely certified) the
 /// bracket is `[0, +∞]`, and the caller evaluates the time exactly. The reciprocals round
 /// relatively: `p ≥ r̃² ≈ D̃ > δ ≥ 10⁻³⁰⁰` (the filter's floor) and, by the inputs' range
-/// `2^±150`, `p < 2⁶¹⁰`, so `i`, `1/d` and `1/r` are normal numbers. (The tests `bracket_ends_hold_the_one_ulp_band` and `bracket_ends_hold_the_box` check that 12u
-/// holds, that a smaller widening does not, and that the bracket holds every root the bounds
-/// allow.)
+/// `2^±150`, `p < 2⁶¹⁰`, so `i`, `1/d` and `1/r` are normal numbers. (The tests
+/// `bracket_ends_hold_the_one_ulp_band` and `bracket_ends_hold_the_box` check that 12u holds,
+/// that a smaller widening does not, and that the bracket holds every root the bounds allow.)
 #[inline(always)]
 fn bracket_ends(b: (f64, f64), c: (f64, f64), disc: (f64, f64)) -> (f64, f64) {
     widened_ends(b, c, disc, WIDEN)
