@@ -296,10 +296,10 @@ pub enum Bracket {
 /// these expressions and the one ulp of the returned time. Typical pairs get a bracket some
 /// tens of ulps wide (it is the plain f64 `c`, whose error grows like u·(|Δr|² + σ²)/c near
 /// contact, that would make it hundreds) at the cost of one square root, one division and a
-/// dozen error-free operations; the double-double
-/// root is left for the one pair that needs it. When the filter
-/// cannot decide, the exact path runs and the answer is [`Bracket::Known`]. A lower end
-/// later than `horizon` gives [`Bracket::Beyond`] (pass `+∞` for none).
+/// dozen error-free operations; the double-double root is left for the one pair that needs
+/// it. When the filter cannot decide, the exact path runs and the answer is
+/// [`Bracket::Known`]. A lower end later than `horizon` gives [`Bracket::Beyond`] (pass `+∞`
+/// for none).
 ///
 /// ```
 /// use quadratic::{contact_bracket, Ball, Bracket};
