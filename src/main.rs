@@ -24,7 +24,7 @@ macro_rules! say {
 #[command(
     name = "collide",
     version,
-    about = "Event-driven hard-disk dynamics on verified collision numerics",
+    about = "Event-driven dynamics of hard disks and spheres on verified collision numerics",
     disable_help_subcommand = true,
     after_help = "Exit status: 0 success; 1 a check failed, a run was stopped by its watchdog, or a JSON line could not be answered; 2 bad input (arguments, configuration, checkpoint, output directory); 130 interrupted (SIGINT or SIGTERM: the run saved a checkpoint and a summary)."
 )]
