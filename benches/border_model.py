@@ -31,22 +31,19 @@ INF = float("inf")
 def efficiency(f, h, overtake=False, cv=0.5, n=50_000, seed=1):
     rng = random.Random(seed)
     k = 1.0 / cv**2
-    times, border, cost = [], [], []
-    for _ in range(2):
-        t, ts, bs, cs = 0.0, [], [], []
+    # Each core's events as two streams in order of time, 0 away from the border and 1 at it:
+    # their simulated times and their work.
+    stimes = [[[], []], [[], []]]
+    work = [[[], []], [[], []]]
+    for a in range(2):
+        t = 0.0
         for _ in range(n):
             t += rng.expovariate(1.0)
-            ts.append(t)
-            bs.append(rng.random() < f)
-            cs.append(rng.gammavariate(k, 1.0 / k))
-        times.append(ts)
-        border.append(bs)
-        cost.append(cs)
-    # Each core's events as two streams in order of time: 0 away from the border, 1 at it.
-    streams = [[[i for i in range(n) if border[a][i] == bool(s)] for s in (0, 1)] for a in range(2)]
-    stimes = [[[times[a][i] for i in streams[a][s]] for s in (0, 1)] for a in range(2)]
+            s = int(rng.random() < f)
+            stimes[a][s].append(t)
+            work[a][s].append(rng.gammavariate(k, 1.0 / k))
     done = [[0, 0], [0, 0]]  # events resolved, per core and stream
-    finished = [[[0.0] * len(streams[a][s]) for s in (0, 1)] for a in range(2)]  # their wall times
+    finished = [[[0.0] * len(stimes[a][s]) for s in (0, 1)] for a in range(2)]  # their wall times
     wall = [0.0, 0.0]  # each core's wall clock
 
     def passed(b, t):
@@ -76,7 +73,7 @@ def efficiency(f, h, overtake=False, cv=0.5, n=50_000, seed=1):
             s, start = 0, wall[a]
         else:
             return False  # its next event waits for the other core
-        wall[a] = start + cost[a][streams[a][s][done[a][s]]] + (h if s else 0.0)
+        wall[a] = start + work[a][s][done[a][s]] + (h if s else 0.0)
         finished[a][s][done[a][s]] = wall[a]
         done[a][s] += 1
         return True
@@ -85,7 +82,7 @@ def efficiency(f, h, overtake=False, cv=0.5, n=50_000, seed=1):
         a = 0 if wall[0] <= wall[1] else 1
         if not step(a):
             assert step(1 - a), "the schedule cannot deadlock: the earliest event can always go"
-    return (sum(cost[0]) + sum(cost[1])) / (2.0 * max(wall))
+    return sum(sum(w) for core in work for w in core) / (2.0 * max(wall))
 
 
 if __name__ == "__main__":
