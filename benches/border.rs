@@ -1,0 +1,419 @@
+//! What dividing space between two cores could keep, replayed from the engine's own events.
+//!
+//! The box (spheres at η = 0.45, the benchmark report's start, warmed up as `collide bench`
+//! does) is cut into two slabs across x, one a core. The engine then runs serially and each
+//! event it reports — a collision of `a` and `b`, or `a` leaving its skin — is given to the
+//! core whose slab holds `a` at the event's time. Replayed on two ideal cores, each resolves
+//! its own events in order of time, one unit of work each; an event starts only once its
+//! core is free and every event of the *other* core it depends on has finished, and it costs
+//! `h` more when it reads anything the other core wrote (the hand-over between their
+//! caches). Two notions of "depends on" give two schedules:
+//!
+//! * **neighbours**: an event reads its particles and every particle within `R + s` of
+//!   either (all their list members could be: `R` the list range, `s` the skin), and depends
+//!   on the last event that changed each of them. What an engine needs that predicts from
+//!   whatever state it reads, and waits (or undoes its work) when any of it may change: a
+//!   conservative division with perfect knowledge of what is safe, or an optimistic one that
+//!   undoes an event whenever a neighbour it read changes course earlier in time.
+//! * **partners**: an event depends only on the last event of each of its own particles —
+//!   the physical causality. An optimistic engine that checks, when a neighbour it read
+//!   changes course earlier, whether the new course meets its particles first (and undoes
+//!   only then) can do no better than this, and no engine that resolves events in order of
+//!   time on each core can beat it.
+//!
+//! Printed per size: the share of events with a dependency on the other core, and the share
+//! of the two cores kept, `events / (2 · the busier core's finishing time)` (1: both busy
+//! throughout; 0.5: nothing gained over one core), for `h` = 0 … 0.3 of an event. Undo logs,
+//! messages and clocks cost nothing here: each figure bounds what a real engine of its kind
+//! keeps. Rebuilds change no course (only lists), so nothing depends on them.
+//!
+//! ```text
+//! cargo bench --bench border                          # N = 10 976 and 97 556, 10⁶ events each
+//! cargo bench --bench border -- 10976 --events 2000000
+//! ```
+//!
+//! With `--test` (as `cargo bench -- --test` runs every bench) it checks the schedule on
+//! cases with known answers and replays a small system.
+
+use collide::engine::{Outcome, RANGE_HOLDS_3D, SimBox, Simulation};
+use nalgebra::Vector3;
+
+/// Packing fraction of the replayed fluid.
+const ETA: f64 = 0.45;
+/// The hand-over costs, in units of an event's work.
+const HANDOVERS: [f64; 4] = [0.0, 0.1, 0.2, 0.3];
+
+/// An event as the replay sees it: the core that resolves it, the particles it changes
+/// (none for a rebuild), its own and those it reads beyond them (its neighbours), and
+/// whether the other core can change any of those (within a contact distance of the
+/// border, or last changed there).
+struct Replayed<'a> {
+    side: usize,
+    writes: &'a [u32],
+    own: &'a [u32],
+    near: &'a [u32],
+    border: bool,
+}
+
+/// What an event waits for.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum Rule {
+    /// At the border, the other core's clock: every event of the other core before its time
+    /// (a conservative division, as `benches/border_model.py` models it).
+    Clock,
+    /// The last event that changed any of its particles or neighbours, on the other core.
+    Neighbours,
+    /// The last event of each of its own particles, on the other core.
+    Partners,
+}
+
+impl Rule {
+    const ALL: [Rule; 3] = [Rule::Clock, Rule::Neighbours, Rule::Partners];
+
+    fn name(self) -> &'static str {
+        match self {
+            Rule::Clock => "the other core's clock",
+            Rule::Neighbours => "neighbours",
+            Rule::Partners => "partners",
+        }
+    }
+}
+
+/// Two cores resolving their events in order, an event waiting for the other core's events
+/// it depends on. `writer_core[m]` and `writer_done[m]`: the core of the last event that
+/// changed particle `m` and when it finished (`u8::MAX`: none yet).
+struct Schedule {
+    rule: Rule,
+    h: f64,
+    clock: [f64; 2],
+    writer_done: Vec<f64>,
+    events: u64,
+    per_side: [u64; 2],
+    crossing: u64,
+    waited: u64,
+}
+
+impl Schedule {
+    fn new(n: usize, rule: Rule, h: f64) -> Self {
+        Schedule {
+            rule,
+            h,
+            clock: [0.0; 2],
+            writer_done: vec![0.0; n],
+            events: 0,
+            per_side: [0; 2],
+            crossing: 0,
+            waited: 0,
+        }
+    }
+
+    /// Places event `e`; `writer_core` is shared by every schedule (the same events change
+    /// the same particles) and updated by the caller after all have placed `e`.
+    fn place(&mut self, e: &Replayed, writer_core: &[u8]) {
+        let mut ready = self.clock[e.side];
+        let mut crosses = false;
+        let reads = match self.rule {
+            Rule::Clock => {
+                if e.border {
+                    crosses = true;
+                    ready = ready.max(self.clock[1 - e.side]);
+                }
+                [&[][..], &[][..]]
+            }
+            Rule::Neighbours => [e.own, e.near],
+            Rule::Partners => [e.own, &[][..]],
+        };
+        for &m in reads.into_iter().flatten() {
+            let core = writer_core[m as usize];
+            if core != u8::MAX && core as usize != e.side {
+                crosses = true;
+                ready = ready.max(self.writer_done[m as usize]);
+            }
+        }
+        self.waited += (ready > self.clock[e.side]) as u64;
+        let done = ready + 1.0 + if crosses { self.h } else { 0.0 };
+        self.clock[e.side] = done;
+        for &m in e.writes {
+            self.writer_done[m as usize] = done;
+        }
+        self.events += 1;
+        self.per_side[e.side] += 1;
+        self.crossing += crosses as u64;
+    }
+
+    /// The share of the two cores kept.
+    fn kept(&self) -> f64 {
+        self.events as f64 / (2.0 * self.clock[0].max(self.clock[1]))
+    }
+
+    /// The share the slabs' unequal numbers of events alone would keep.
+    fn balance(&self) -> f64 {
+        self.events as f64 / (2.0 * self.per_side[0].max(self.per_side[1]) as f64)
+    }
+}
+
+/// The particles within `reach` of a point, found through a grid of cells at least
+/// `reach + 2·slack` wide built from the positions at `built`; rebuilt (by the caller)
+/// before any particle can have moved `slack` since.
+struct Grid {
+    cells: [usize; 3],
+    width: [f64; 3],
+    heads: Vec<u32>,
+    next: Vec<u32>,
+    built: f64,
+    valid_until: f64,
+}
+
+impl Grid {
+    const SLACK: f64 = 0.1;
+
+    fn build(sim: &Simulation<3>, reach: f64) -> Self {
+        let lengths = sim.sim_box().lengths;
+        let cells: [usize; 3] =
+            std::array::from_fn(|a| ((lengths[a] / (reach + 2.0 * Self::SLACK)).floor() as usize).max(1));
+        let width = std::array::from_fn(|a| lengths[a] / cells[a] as f64);
+        let mut grid = Grid {
+            cells,
+            width,
+            heads: vec![u32::MAX; cells.iter().product()],
+            next: vec![u32::MAX; sim.particles().len()],
+            built: sim.time(),
+            valid_until: 0.0,
+        };
+        for (i, r) in sim.wrapped_positions().iter().enumerate() {
+            let c = grid.cell_of(r);
+            grid.next[i] = grid.heads[c];
+            grid.heads[c] = i as u32;
+        }
+        // A collision changes speeds by at most a factor √2 (energy is shared, never made),
+        // so twice the fastest speed bounds every speed over so short a time.
+        let fastest = sim.particles().iter().map(|p| p.velocity.norm()).fold(0.0, f64::max);
+        grid.valid_until = grid.built + Self::SLACK / (2.0 * fastest);
+        grid
+    }
+
+    fn coord(&self, r: &Vector3<f64>) -> [usize; 3] {
+        std::array::from_fn(|a| ((r[a] / self.width[a]).floor() as usize).min(self.cells[a] - 1))
+    }
+
+    fn cell_of(&self, r: &Vector3<f64>) -> usize {
+        let c = self.coord(r);
+        (c[2] * self.cells[1] + c[1]) * self.cells[0] + c[0]
+    }
+
+    /// Pushes onto `out` every particle within `reach` of `centre` (a position at `t`,
+    /// wrapped), minimum image.
+    fn within(&self, sim: &Simulation<3>, centre: &Vector3<f64>, t: f64, reach: f64, out: &mut Vec<u32>) {
+        let sim_box: &SimBox<3> = sim.sim_box();
+        let c = self.coord(centre);
+        let span = |a: usize| -> Vec<usize> {
+            let k = self.cells[a];
+            if k < 3 { (0..k).collect() } else { vec![(c[a] + k - 1) % k, c[a], (c[a] + 1) % k] }
+        };
+        for z in span(2) {
+            for y in span(1) {
+                for x in span(0) {
+                    let mut m = self.heads[(z * self.cells[1] + y) * self.cells[0] + x];
+                    while m != u32::MAX {
+                        let mut d = sim.particles()[m as usize].position_at(t) - centre;
+                        d += sim_box.minimum_image_shift(&d);
+                        if d.norm_squared() < reach * reach {
+                            out.push(m);
+                        }
+                        m = self.next[m as usize];
+                    }
+                }
+            }
+        }
+    }
+}
+
+/// The list range and skin the engine chooses for spheres of diameter 1 at `ETA`
+/// (`RANGE_HOLDS_3D` particles in range on average, the skin the rest beyond contact).
+fn range_and_skin() -> (f64, f64) {
+    let density = ETA * 6.0 / std::f64::consts::PI;
+    let range = (RANGE_HOLDS_3D / (4.0 / 3.0 * std::f64::consts::PI * density)).cbrt();
+    (range, range - 1.0)
+}
+
+/// Replays `events` events of `n` spheres after the warm-up; one schedule per dependency
+/// notion and hand-over cost.
+fn replay(n: usize, events: u64) -> Vec<Schedule> {
+    let (particles, sim_box) = collide::bench::state::initial_state::<3>(n, ETA, 1).expect("a benchmark start");
+    let mut sim = Simulation::new(particles, sim_box).expect("a valid start");
+    while sim.counts().pair < collide::bench::WARMUP * n as u64 {
+        sim.step().expect("events go on");
+    }
+    let (range, skin) = range_and_skin();
+    let reach = range + skin;
+    let half = 0.5 * sim.sim_box().lengths[0];
+    let mut schedules: Vec<Schedule> =
+        Rule::ALL.into_iter().flat_map(|rule| HANDOVERS.map(|h| Schedule::new(n, rule, h))).collect();
+    let mut writer_core = vec![u8::MAX; n];
+    let mut grid = Grid::build(&sim, reach);
+    let (mut near, mut seen) = (Vec::new(), 0u64);
+    while seen < events {
+        let outcome = sim.step().expect("events go on");
+        let t = sim.time();
+        let (own, writes): ([u32; 2], usize) = match outcome {
+            Outcome::Pair { i, j, .. } => ([i as u32, j as u32], 2),
+            Outcome::Rebuild { i } => ([i as u32, i as u32], 0),
+            _ => continue,
+        };
+        if t > grid.valid_until {
+            grid = Grid::build(&sim, reach);
+        }
+        let wrap = |r: Vector3<f64>| r.zip_map(&sim.sim_box().lengths, |x, l| x.rem_euclid(l));
+        let at = |m: u32| wrap(sim.particles()[m as usize].position_at(t));
+        let side = (at(own[0])[0] >= half) as usize;
+        near.clear();
+        for &m in &own[..if writes == 2 { 2 } else { 1 }] {
+            grid.within(&sim, &at(m), t, reach, &mut near);
+        }
+        // A sphere the other core can change: within a contact distance of the other slab
+        // (a collision across the border, resolved there, moves it), or last changed there.
+        let other = |m: &u32| {
+            let x = at(*m)[0];
+            let to_border = x.min((x - half).abs()).min(2.0 * half - x);
+            to_border < 1.0 || (writer_core[*m as usize] != u8::MAX && writer_core[*m as usize] as usize != side)
+        };
+        let border = own.iter().chain(&near).any(other);
+        let e = Replayed { side, writes: &own[..writes], own: &own, near: &near, border };
+        for s in &mut schedules {
+            s.place(&e, &writer_core);
+        }
+        for &m in e.writes {
+            writer_core[m as usize] = side as u8;
+        }
+        seen += 1;
+    }
+    schedules
+}
+
+fn report(n: usize, events: u64) {
+    let schedules = replay(n, events);
+    let (range, skin) = range_and_skin();
+    println!(
+        "N = {n}, η = {ETA}, {events} events after the warm-up; two slabs across x; reads within R + s = {:.3}σ",
+        range + skin
+    );
+    println!(
+        "| depends on | events crossing | waiting, h = 0 | balance | kept, h = {} |",
+        HANDOVERS.map(|h| h.to_string()).join(" | ")
+    );
+    for rule in Rule::ALL {
+        let row: Vec<&Schedule> = schedules.iter().filter(|s| s.rule == rule).collect();
+        let kept: Vec<String> = row.iter().map(|s| format!("{:.3}", s.kept())).collect();
+        println!(
+            "| {} | {:.3} | {:.4} | {:.3} | {} |",
+            rule.name(),
+            row[0].crossing as f64 / row[0].events as f64,
+            row[0].waited as f64 / row[0].events as f64,
+            row[0].balance(),
+            kept.join(" | ")
+        );
+    }
+}
+
+/// The schedule on cases with known answers, then a small replay whose shares must be
+/// shares. Fails loudly (a panic is the bench harness's failure).
+fn check() {
+    // Alternating sides, nothing shared: both cores busy throughout, whatever the rule.
+    for rule in Rule::ALL {
+        let mut s = Schedule::new(2, rule, 0.0);
+        for k in 0..1000u32 {
+            let m = [k % 2];
+            s.place(&Replayed { side: (k % 2) as usize, writes: &m, own: &m, near: &[], border: false }, &[0, 1]);
+        }
+        assert!((s.kept() - 1.0).abs() < 1e-12, "{rule:?}: independent halves kept {}", s.kept());
+    }
+    // A chain through one particle handed from side to side: one core at a time; with a
+    // hand-over cost of 0.2, paid by every event but the first.
+    for (h, expected) in [(0.0, 0.5), (0.2, 1000.0 / (2.0 * (1000.0 + 999.0 * 0.2)))] {
+        let mut s = Schedule::new(1, Rule::Partners, h);
+        let mut cores = [u8::MAX];
+        for k in 0..1000u32 {
+            let m = [0u32];
+            s.place(&Replayed { side: (k % 2) as usize, writes: &m, own: &m, near: &[], border: true }, &cores);
+            cores[0] = (k % 2) as u8;
+        }
+        assert!((s.kept() - expected).abs() < 1e-9, "a chain with h = {h} kept {}", s.kept());
+    }
+    // A neighbour last changed on the other side, and at the border: only the rule that
+    // counts it waits (the clock makes everything at the border wait).
+    for (rule, expected) in [(Rule::Clock, 0.5), (Rule::Neighbours, 0.5), (Rule::Partners, 1.0)] {
+        let mut s = Schedule::new(2, rule, 0.0);
+        for k in 0..1000u32 {
+            let (side, m, other) = ((k % 2) as usize, [k % 2], [1 - k % 2]);
+            s.place(&Replayed { side, writes: &m, own: &m, near: &other, border: true }, &[0, 1]);
+        }
+        assert!((s.kept() - expected).abs() < 1e-12, "{rule:?}: kept {}", s.kept());
+    }
+    // The grid finds exactly the particles within reach (against all pairs), on a fluid
+    // that has moved since the grid was built.
+    let (particles, sim_box) = collide::bench::state::initial_state::<3>(500, ETA, 1).expect("a benchmark start");
+    let mut sim = Simulation::new(particles, sim_box).expect("a valid start");
+    for _ in 0..20_000 {
+        sim.step().expect("events go on");
+    }
+    let reach = range_and_skin().0 + range_and_skin().1;
+    let grid = Grid::build(&sim, reach);
+    while sim.time() < grid.valid_until {
+        sim.step().expect("events go on");
+    }
+    let t = grid.valid_until;
+    let at: Vec<Vector3<f64>> = sim
+        .particles()
+        .iter()
+        .map(|p| p.position_at(t).zip_map(&sim.sim_box().lengths, |x, l| x.rem_euclid(l)))
+        .collect();
+    let mut total = 0;
+    for centre in &at {
+        let mut found = Vec::new();
+        grid.within(&sim, centre, t, reach, &mut found);
+        found.sort_unstable();
+        let all: Vec<u32> = (0..at.len() as u32)
+            .filter(|&m| {
+                let mut d = at[m as usize] - centre;
+                d += sim.sim_box().minimum_image_shift(&d);
+                d.norm_squared() < reach * reach
+            })
+            .collect();
+        assert_eq!(found, all, "the grid's neighbours differ from all pairs'");
+        total += all.len();
+    }
+    assert!(total > 10 * at.len(), "too few neighbours to test the grid: {total}");
+    for s in replay(500, 20_000) {
+        let crossing = s.crossing as f64 / s.events as f64;
+        assert!(
+            (0.5 / (1.0 + s.h) - 1e-9..=1.0).contains(&s.kept()) && (0.0..=1.0).contains(&crossing),
+            "kept {}",
+            s.kept()
+        );
+    }
+    println!("border: schedule checks passed");
+}
+
+fn main() {
+    let args: Vec<String> = std::env::args().skip(1).filter(|a| a != "--bench").collect();
+    if args.iter().any(|a| a == "--test") {
+        check();
+        return;
+    }
+    let mut sizes = Vec::new();
+    let mut events = 1_000_000;
+    let mut it = args.iter();
+    while let Some(a) = it.next() {
+        if a == "--events" {
+            events = it.next().and_then(|v| v.parse().ok()).expect("--events takes a count");
+        } else {
+            sizes.push(a.parse::<usize>().unwrap_or_else(|_| panic!("not a particle count: {a}")));
+        }
+    }
+    if sizes.is_empty() {
+        sizes = vec![10_976, 97_556];
+    }
+    for n in sizes {
+        report(n, events);
+    }
+}
