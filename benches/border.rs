@@ -7,7 +7,7 @@
 //! its own events in order of time, one unit of work each; an event starts only once its
 //! core is free and every event of the *other* core it depends on has finished, and it costs
 //! `h` more when it reads anything the other core wrote (the hand-over between their
-//! caches). Two notions of "depends on" give two schedules:
+//! caches). What "depends on" means gives the schedules ([`Rule`]):
 //!
 //! * **neighbours**: an event reads its particles and every particle within `R + s` of
 //!   either (all their list members could be: `R` the list range, `s` the skin), and depends
@@ -15,13 +15,20 @@
 //!   whatever state it reads, and waits (or undoes its work) when any of it may change: a
 //!   conservative division with perfect knowledge of what is safe, or an optimistic one that
 //!   undoes an event whenever a neighbour it read changes course earlier in time.
+//! * **neighbours, undo for W**: as neighbours, with undo records kept for only W of a
+//!   core's events beyond the other core's clock.
+//! * **the other core's clock**: an event that reads a particle the other core can change
+//!   (within a contact distance of the other slab, or last changed there) waits until the
+//!   other core has resolved every event before its time — a conservative division.
 //! * **partners**: an event depends only on the last event of each of its own particles —
 //!   the physical causality. An optimistic engine that checks, when a neighbour it read
 //!   changes course earlier, whether the new course meets its particles first (and undoes
 //!   only then) can do no better than this, and no engine that resolves events in order of
 //!   time on each core can beat it.
 //!
-//! Printed per size: the share of events with a dependency on the other core, and the share
+//! Printed per size and rule: the share of events that cross (read what the other core
+//! wrote or, for the clock, can change), the share that wait at all (with `h` = 0), the
+//! slabs' balance (what their unequal numbers of events alone would keep), and the share
 //! of the two cores kept, `events / (2 · the busier core's finishing time)` (1: both busy
 //! throughout; 0.5: nothing gained over one core), for `h` = 0 … 0.3 of an event. Undo logs,
 //! messages and clocks cost nothing here: each figure bounds what a real engine of its kind
@@ -48,6 +55,7 @@ const HANDOVERS: [f64; 4] = [0.0, 0.1, 0.2, 0.3];
 /// whether the other core can change any of those (within a contact distance of the
 /// border, or last changed there).
 struct Replayed<'a> {
+    time: f64,
     side: usize,
     writes: &'a [u32],
     own: &'a [u32],
@@ -65,16 +73,21 @@ enum Rule {
     Neighbours,
     /// The last event of each of its own particles, on the other core.
     Partners,
+    /// As `Neighbours`, and with undo records for only this many of a core's events beyond
+    /// the other core's clock: an event also waits until the other core has resolved every
+    /// event before the one this many events back on its own core.
+    Window(usize),
 }
 
 impl Rule {
-    const ALL: [Rule; 3] = [Rule::Clock, Rule::Neighbours, Rule::Partners];
+    const ALL: [Rule; 5] = [Rule::Clock, Rule::Neighbours, Rule::Window(64), Rule::Window(16), Rule::Partners];
 
-    fn name(self) -> &'static str {
+    fn name(self) -> String {
         match self {
-            Rule::Clock => "the other core's clock",
-            Rule::Neighbours => "neighbours",
-            Rule::Partners => "partners",
+            Rule::Clock => "the other core's clock".into(),
+            Rule::Neighbours => "neighbours".into(),
+            Rule::Window(w) => format!("neighbours, undo for {w}"),
+            Rule::Partners => "partners".into(),
         }
     }
 }
@@ -91,6 +104,8 @@ struct Schedule {
     per_side: [u64; 2],
     crossing: u64,
     waited: u64,
+    /// Each core's events so far: their times and when they finished.
+    history: [Vec<(f64, f64)>; 2],
 }
 
 impl Schedule {
@@ -104,6 +119,7 @@ impl Schedule {
             per_side: [0; 2],
             crossing: 0,
             waited: 0,
+            history: [Vec::new(), Vec::new()],
         }
     }
 
@@ -121,6 +137,17 @@ impl Schedule {
                 [&[][..], &[][..]]
             }
             Rule::Neighbours => [e.own, e.near],
+            Rule::Window(w) => {
+                let (own, other) = (&self.history[e.side], &self.history[1 - e.side]);
+                if own.len() >= w {
+                    let back = own[own.len() - w].0;
+                    let passed = other.partition_point(|&(t, _)| t < back);
+                    if passed > 0 {
+                        ready = ready.max(other[passed - 1].1);
+                    }
+                }
+                [e.own, e.near]
+            }
             Rule::Partners => [e.own, &[][..]],
         };
         for &m in reads.into_iter().flatten() {
@@ -133,6 +160,7 @@ impl Schedule {
         self.waited += (ready > self.clock[e.side]) as u64;
         let done = ready + 1.0 + if crosses { self.h } else { 0.0 };
         self.clock[e.side] = done;
+        self.history[e.side].push((e.time, done));
         for &m in e.writes {
             self.writer_done[m as usize] = done;
         }
@@ -278,7 +306,7 @@ fn replay(n: usize, events: u64) -> Vec<Schedule> {
             to_border < 1.0 || (writer_core[*m as usize] != u8::MAX && writer_core[*m as usize] as usize != side)
         };
         let border = own.iter().chain(&near).any(other);
-        let e = Replayed { side, writes: &own[..writes], own: &own, near: &near, border };
+        let e = Replayed { time: t, side, writes: &own[..writes], own: &own, near: &near, border };
         for s in &mut schedules {
             s.place(&e, &writer_core);
         }
@@ -298,7 +326,7 @@ fn report(n: usize, events: u64) {
         range + skin
     );
     println!(
-        "| depends on | events crossing | waiting, h = 0 | balance | kept, h = {} |",
+        "| waits for | events that cross | waiting, h = 0 | balance | kept, h = {} |",
         HANDOVERS.map(|h| h.to_string()).join(" | ")
     );
     for rule in Rule::ALL {
@@ -323,7 +351,10 @@ fn check() {
         let mut s = Schedule::new(2, rule, 0.0);
         for k in 0..1000u32 {
             let m = [k % 2];
-            s.place(&Replayed { side: (k % 2) as usize, writes: &m, own: &m, near: &[], border: false }, &[0, 1]);
+            s.place(
+                &Replayed { time: k as f64, side: (k % 2) as usize, writes: &m, own: &m, near: &[], border: false },
+                &[0, 1],
+            );
         }
         assert!((s.kept() - 1.0).abs() < 1e-12, "{rule:?}: independent halves kept {}", s.kept());
     }
@@ -334,7 +365,10 @@ fn check() {
         let mut cores = [u8::MAX];
         for k in 0..1000u32 {
             let m = [0u32];
-            s.place(&Replayed { side: (k % 2) as usize, writes: &m, own: &m, near: &[], border: true }, &cores);
+            s.place(
+                &Replayed { time: k as f64, side: (k % 2) as usize, writes: &m, own: &m, near: &[], border: true },
+                &cores,
+            );
             cores[0] = (k % 2) as u8;
         }
         assert!((s.kept() - expected).abs() < 1e-9, "a chain with h = {h} kept {}", s.kept());
@@ -345,7 +379,22 @@ fn check() {
         let mut s = Schedule::new(2, rule, 0.0);
         for k in 0..1000u32 {
             let (side, m, other) = ((k % 2) as usize, [k % 2], [1 - k % 2]);
-            s.place(&Replayed { side, writes: &m, own: &m, near: &other, border: true }, &[0, 1]);
+            s.place(&Replayed { time: k as f64, side, writes: &m, own: &m, near: &other, border: true }, &[0, 1]);
+        }
+        assert!((s.kept() - expected).abs() < 1e-12, "{rule:?}: kept {}", s.kept());
+    }
+    // One core's events all before the other's, nothing shared: without a window both run
+    // at once; with undo for ten events the later core cannot run more than ten ahead of
+    // the earlier one's clock: its first ten run at once, the rest after all of the other's.
+    for (rule, expected) in [(Rule::Neighbours, 1.0), (Rule::Window(10), 2000.0 / (2.0 * 1990.0))] {
+        let mut s = Schedule::new(2000, rule, 0.0);
+        for k in 0..2000u32 {
+            let side = (k >= 1000) as usize;
+            let m = [k];
+            s.place(
+                &Replayed { time: k as f64, side, writes: &m, own: &m, near: &[], border: false },
+                &[u8::MAX; 2000],
+            );
         }
         assert!((s.kept() - expected).abs() < 1e-12, "{rule:?}: kept {}", s.kept());
     }
