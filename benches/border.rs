@@ -256,6 +256,17 @@ impl Grid {
     }
 }
 
+/// Spheres' records that cross between the two cores' caches (their capacity aside): a
+/// core reading a record the other core changed since this core last read it, or changing
+/// one the other core holds a copy of. An event reads its own spheres and the members of
+/// their lists, taken as every sphere within the list range `R` of either.
+#[derive(Default)]
+struct Traffic {
+    reads: u64,
+    writes: u64,
+    events: u64,
+}
+
 /// The list range and skin the engine chooses for spheres of diameter 1 at `ETA`
 /// (`RANGE_HOLDS_3D` particles in range on average, the skin the rest beyond contact).
 fn range_and_skin() -> (f64, f64) {
@@ -266,7 +277,7 @@ fn range_and_skin() -> (f64, f64) {
 
 /// Replays `events` events of `n` spheres after the warm-up; one schedule per dependency
 /// notion and hand-over cost.
-fn replay(n: usize, events: u64) -> Vec<Schedule> {
+fn replay(n: usize, events: u64) -> (Vec<Schedule>, Traffic) {
     let (particles, sim_box) = collide::bench::state::initial_state::<3>(n, ETA, 1).expect("a benchmark start");
     let mut sim = Simulation::new(particles, sim_box).expect("a valid start");
     while sim.counts().pair < collide::bench::WARMUP * n as u64 {
@@ -279,7 +290,10 @@ fn replay(n: usize, events: u64) -> Vec<Schedule> {
         Rule::ALL.into_iter().flat_map(|rule| HANDOVERS.map(|h| Schedule::new(n, rule, h))).collect();
     let mut writer_core = vec![u8::MAX; n];
     let mut grid = Grid::build(&sim, reach);
-    let (mut near, mut seen) = (Vec::new(), 0u64);
+    let (mut near, mut listed, mut seen) = (Vec::new(), Vec::new(), 0u64);
+    let mut traffic = Traffic::default();
+    // Which cores hold the present version of each sphere's record.
+    let mut holds = vec![[true; 2]; n];
     while seen < events {
         let outcome = sim.step().expect("events go on");
         let t = sim.time();
@@ -313,17 +327,42 @@ fn replay(n: usize, events: u64) -> Vec<Schedule> {
         for &m in e.writes {
             writer_core[m as usize] = side as u8;
         }
+        listed.clear();
+        listed.extend(own[..if writes == 2 { 2 } else { 1 }].iter().copied());
+        listed.extend(near.iter().copied().filter(|&m| {
+            own.iter().any(|&o| {
+                let mut d = at(m) - at(o);
+                d += sim.sim_box().minimum_image_shift(&d);
+                d.norm_squared() < range * range
+            })
+        }));
+        listed.sort_unstable();
+        listed.dedup();
+        for &m in &listed {
+            traffic.reads += !holds[m as usize][side] as u64;
+            holds[m as usize][side] = true;
+        }
+        for &m in e.writes {
+            traffic.writes += holds[m as usize][1 - side] as u64;
+            holds[m as usize] = [side == 0, side == 1];
+        }
+        traffic.events += 1;
         seen += 1;
     }
-    schedules
+    (schedules, traffic)
 }
 
 fn report(n: usize, events: u64) {
-    let schedules = replay(n, events);
+    let (schedules, traffic) = replay(n, events);
     let (range, skin) = range_and_skin();
     println!(
         "N = {n}, η = {ETA}, {events} events after the warm-up; two slabs across x; reads within R + s = {:.3}σ",
         range + skin
+    );
+    println!(
+        "records crossing between the cores' caches, per event: {:.3} read, {:.3} changed (lists within R = {range:.3}σ)",
+        traffic.reads as f64 / traffic.events as f64,
+        traffic.writes as f64 / traffic.events as f64
     );
     println!(
         "| waits for | events that cross | waiting, h = 0 | balance | kept, h = {} |",
@@ -432,7 +471,9 @@ fn check() {
         total += all.len();
     }
     assert!(total > 10 * at.len(), "too few neighbours to test the grid: {total}");
-    for s in replay(500, 20_000) {
+    let (schedules, traffic) = replay(500, 20_000);
+    assert!(traffic.reads > 0 && traffic.writes > 0 && traffic.reads < 40 * traffic.events, "traffic");
+    for s in schedules {
         let crossing = s.crossing as f64 / s.events as f64;
         assert!(
             (0.5 / (1.0 + s.h) - 1e-9..=1.0).contains(&s.kept()) && (0.0..=1.0).contains(&crossing),
