@@ -51,14 +51,13 @@ const ETA: f64 = 0.45;
 /// The hand-over costs, in units of an event's work.
 const HANDOVERS: [f64; 4] = [0.0, 0.1, 0.2, 0.3];
 
-/// An event as the replay sees it: the core that resolves it, the particles it changes
-/// (its own sphere for a rebuild), its own and those it reads beyond them (its neighbours), and
-/// whether the other core can change any of those (within a contact distance of the
-/// border, or last changed there).
+/// An event as the replay sees it: the core that resolves it, its own spheres (the two of a
+/// collision, the one of a rebuild: those it changes), those it reads beyond them (its
+/// neighbours), and whether the other core can change any of those (within a contact
+/// distance of the border, or last changed there).
 struct Replayed<'a> {
     time: f64,
     side: usize,
-    writes: &'a [u32],
     own: &'a [u32],
     near: &'a [u32],
     border: bool,
@@ -162,7 +161,7 @@ impl Schedule {
         let done = ready + 1.0 + if crosses { self.h } else { 0.0 };
         self.clock[e.side] = done;
         self.history[e.side].push((e.time, done));
-        for &m in e.writes {
+        for &m in e.own {
             self.writer_done[m as usize] = done;
         }
         self.events += 1;
@@ -182,14 +181,13 @@ impl Schedule {
 }
 
 /// The particles within `reach` of a point, found through a grid of cells at least
-/// `reach + 2·slack` wide built from the positions at `built`; rebuilt (by the caller)
+/// `reach + 2·slack` wide, from the positions of one instant; rebuilt (by the caller)
 /// before any particle can have moved `slack` since.
 struct Grid {
     cells: [usize; 3],
     width: [f64; 3],
     heads: Vec<u32>,
     next: Vec<u32>,
-    built: f64,
     valid_until: f64,
 }
 
@@ -206,7 +204,6 @@ impl Grid {
             width,
             heads: vec![u32::MAX; cells.iter().product()],
             next: vec![u32::MAX; sim.particles().len()],
-            built: sim.time(),
             valid_until: 0.0,
         };
         for (i, r) in sim.wrapped_positions().iter().enumerate() {
@@ -217,7 +214,7 @@ impl Grid {
         // A collision changes speeds by at most a factor √2 (energy is shared, never made),
         // so twice the fastest speed bounds every speed over so short a time.
         let fastest = sim.particles().iter().map(|p| p.velocity.norm()).fold(0.0, f64::max);
-        grid.valid_until = grid.built + Self::SLACK / (2.0 * fastest);
+        grid.valid_until = sim.time() + Self::SLACK / (2.0 * fastest);
         grid
     }
 
@@ -233,7 +230,6 @@ impl Grid {
     /// Pushes onto `out` every particle within `reach` of `centre` (a position at `t`,
     /// wrapped), minimum image.
     fn within(&self, sim: &Simulation<3>, centre: &Vector3<f64>, t: f64, reach: f64, out: &mut Vec<u32>) {
-        let sim_box: &SimBox<3> = sim.sim_box();
         let c = self.coord(centre);
         let span = |a: usize| -> Vec<usize> {
             let k = self.cells[a];
@@ -244,9 +240,7 @@ impl Grid {
                 for x in span(0) {
                     let mut m = self.heads[(z * self.cells[1] + y) * self.cells[0] + x];
                     while m != u32::MAX {
-                        let mut d = sim.particles()[m as usize].position_at(t) - centre;
-                        d += sim_box.minimum_image_shift(&d);
-                        if d.norm_squared() < reach * reach {
+                        if apart2(sim.sim_box(), &sim.particles()[m as usize].position_at(t), centre) < reach * reach {
                             out.push(m);
                         }
                         m = self.next[m as usize];
@@ -266,6 +260,12 @@ struct Traffic {
     reads: u64,
     writes: u64,
     events: u64,
+}
+
+/// The squared distance between `a` and the nearest image of `b`.
+fn apart2(sim_box: &SimBox<3>, a: &Vector3<f64>, b: &Vector3<f64>) -> f64 {
+    let d = b - a;
+    (d + sim_box.minimum_image_shift(&d)).norm_squared()
 }
 
 /// The list range and skin the engine chooses for spheres of diameter 1 at `ETA`
@@ -298,21 +298,22 @@ fn replay(n: usize, events: u64) -> (Vec<Schedule>, Traffic) {
     while seen < events {
         let outcome = sim.step().expect("events go on");
         let t = sim.time();
-        let (own, writes): ([u32; 2], usize) = match outcome {
+        let (pair, spheres): ([u32; 2], usize) = match outcome {
             Outcome::Pair { i, j, .. } => ([i as u32, j as u32], 2),
             // A rebuild changes no course, but the lists around its sphere: what those
             // spheres' events read next depends on it, as on a change of the sphere.
-            Outcome::Rebuild { i } => ([i as u32, i as u32], 1),
+            Outcome::Rebuild { i } => ([i as u32, u32::MAX], 1),
             _ => continue,
         };
         if t > grid.valid_until {
             grid = Grid::build(&sim, reach);
         }
+        let own = &pair[..spheres];
         let wrap = |r: Vector3<f64>| r.zip_map(&sim.sim_box().lengths, |x, l| x.rem_euclid(l));
         let at = |m: u32| wrap(sim.particles()[m as usize].position_at(t));
         let side = (at(own[0])[0] >= half) as usize;
         near.clear();
-        for &m in &own[..if writes == 2 { 2 } else { 1 }] {
+        for &m in own {
             grid.within(&sim, &at(m), t, reach, &mut near);
         }
         // A sphere the other core can change: within a contact distance of the other slab
@@ -323,29 +324,27 @@ fn replay(n: usize, events: u64) -> (Vec<Schedule>, Traffic) {
             to_border < 1.0 || (writer_core[*m as usize] != u8::MAX && writer_core[*m as usize] as usize != side)
         };
         let border = own.iter().chain(&near).any(other);
-        let e = Replayed { time: t, side, writes: &own[..writes], own: &own, near: &near, border };
+        let e = Replayed { time: t, side, own, near: &near, border };
         for s in &mut schedules {
             s.place(&e, &writer_core);
         }
-        for &m in e.writes {
+        for &m in own {
             writer_core[m as usize] = side as u8;
         }
         listed.clear();
-        listed.extend(own[..if writes == 2 { 2 } else { 1 }].iter().copied());
-        listed.extend(near.iter().copied().filter(|&m| {
-            own.iter().any(|&o| {
-                let mut d = at(m) - at(o);
-                d += sim.sim_box().minimum_image_shift(&d);
-                d.norm_squared() < range * range
-            })
-        }));
+        listed.extend(own.iter().copied());
+        listed.extend(
+            near.iter()
+                .copied()
+                .filter(|&m| own.iter().any(|&o| apart2(sim.sim_box(), &at(o), &at(m)) < range * range)),
+        );
         listed.sort_unstable();
         listed.dedup();
         for &m in &listed {
             traffic.reads += !holds[m as usize][side] as u64;
             holds[m as usize][side] = true;
         }
-        for &m in e.writes {
+        for &m in own {
             traffic.writes += holds[m as usize][1 - side] as u64;
             holds[m as usize] = [side == 0, side == 1];
         }
@@ -393,10 +392,7 @@ fn check() {
         let mut s = Schedule::new(2, rule, 0.0);
         for k in 0..1000u32 {
             let m = [k % 2];
-            s.place(
-                &Replayed { time: k as f64, side: (k % 2) as usize, writes: &m, own: &m, near: &[], border: false },
-                &[0, 1],
-            );
+            s.place(&Replayed { time: k as f64, side: (k % 2) as usize, own: &m, near: &[], border: false }, &[0, 1]);
         }
         assert!((s.kept() - 1.0).abs() < 1e-12, "{rule:?}: independent halves kept {}", s.kept());
     }
@@ -407,10 +403,7 @@ fn check() {
         let mut cores = [u8::MAX];
         for k in 0..1000u32 {
             let m = [0u32];
-            s.place(
-                &Replayed { time: k as f64, side: (k % 2) as usize, writes: &m, own: &m, near: &[], border: true },
-                &cores,
-            );
+            s.place(&Replayed { time: k as f64, side: (k % 2) as usize, own: &m, near: &[], border: true }, &cores);
             cores[0] = (k % 2) as u8;
         }
         assert!((s.kept() - expected).abs() < 1e-9, "a chain with h = {h} kept {}", s.kept());
@@ -421,7 +414,7 @@ fn check() {
         let mut s = Schedule::new(2, rule, 0.0);
         for k in 0..1000u32 {
             let (side, m, other) = ((k % 2) as usize, [k % 2], [1 - k % 2]);
-            s.place(&Replayed { time: k as f64, side, writes: &m, own: &m, near: &other, border: true }, &[0, 1]);
+            s.place(&Replayed { time: k as f64, side, own: &m, near: &other, border: true }, &[0, 1]);
         }
         assert!((s.kept() - expected).abs() < 1e-12, "{rule:?}: kept {}", s.kept());
     }
@@ -433,10 +426,7 @@ fn check() {
         for k in 0..2000u32 {
             let side = (k >= 1000) as usize;
             let m = [k];
-            s.place(
-                &Replayed { time: k as f64, side, writes: &m, own: &m, near: &[], border: false },
-                &[u8::MAX; 2000],
-            );
+            s.place(&Replayed { time: k as f64, side, own: &m, near: &[], border: false }, &[u8::MAX; 2000]);
         }
         assert!((s.kept() - expected).abs() < 1e-12, "{rule:?}: kept {}", s.kept());
     }
@@ -463,13 +453,8 @@ fn check() {
         let mut found = Vec::new();
         grid.within(&sim, centre, t, reach, &mut found);
         found.sort_unstable();
-        let all: Vec<u32> = (0..at.len() as u32)
-            .filter(|&m| {
-                let mut d = at[m as usize] - centre;
-                d += sim.sim_box().minimum_image_shift(&d);
-                d.norm_squared() < reach * reach
-            })
-            .collect();
+        let all: Vec<u32> =
+            (0..at.len() as u32).filter(|&m| apart2(sim.sim_box(), centre, &at[m as usize]) < reach * reach).collect();
         assert_eq!(found, all, "the grid's neighbours differ from all pairs'");
         total += all.len();
     }
