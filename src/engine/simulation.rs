@@ -60,6 +60,9 @@ pub struct Simulation<const D: usize> {
     holds_until: Option<f64>,
     search: Search<D>,
     timing: Timing,
+    /// When the box is divided between two slabs ([`divided`]): this one's side, who owns
+    /// each particle, and what it tells the other side. `None`: the whole box.
+    region: Option<Box<divided::Region<D>>>,
 }
 
 /// The saved state of a [`Simulation`]: enough to continue bit-identically.
@@ -152,6 +155,7 @@ impl<const D: usize> Simulation<D> {
             holds_until: None,
             search: Search::new(batch),
             timing,
+            region: None,
         };
         sim.refuse_overlaps(0.0)?;
         sim.predict_everyone();
@@ -361,6 +365,7 @@ impl<const D: usize> Simulation<D> {
             particles,
             search: Search::new(batch),
             timing,
+            region: None,
             short,
             sim_box,
             queue,
@@ -657,6 +662,19 @@ impl<const D: usize> Simulation<D> {
     /// Processes the next event and reports it; `None` when nothing can happen any more.
     pub fn step(&mut self) -> Option<Outcome<D>> {
         loop {
+            match self.take() {
+                Taken::Event(outcome) => return Some(outcome),
+                Taken::Bookkeeping => continue,
+                Taken::End => return None,
+            }
+        }
+    }
+
+    /// Takes the earliest item — an event, a re-prediction marker, a rebuild of the
+    /// neighbourhood while growing — and deals with it.
+    #[inline(always)]
+    fn take(&mut self) -> Taken<D> {
+        {
             let (owner, next) = self.queue.first();
             let end = self.growth.map(|g| Event { time: g.predict(), kind: EventKind::GrowthEnd });
             let ends_first = end.is_some_and(|end| end.before(u32::MAX, &next, owner as u32));
@@ -667,11 +685,11 @@ impl<const D: usize> Simulation<D> {
                 self.time = time;
                 self.sampling.resolve(time);
                 self.counts.record(&Outcome::<D>::Sample);
-                return Some(Outcome::Sample);
+                return Taken::Event(Outcome::Sample);
             }
             if ends_first && let Some(growth) = &self.growth {
                 self.finish_growth(growth.predict(), Ending::Reached);
-                return Some(Outcome::GrowthEnd);
+                return Taken::Event(Outcome::GrowthEnd);
             }
             if let Some(t) = self.holds_until
                 && end.is_some_and(|end| t < end.time)
@@ -684,10 +702,10 @@ impl<const D: usize> Simulation<D> {
                 self.time = t;
                 self.arrange_neighbourhood();
                 self.predict_everyone();
-                continue;
+                return Taken::Bookkeeping;
             }
             if next.kind == EventKind::Nothing {
-                return None;
+                return Taken::End;
             }
             if !next.is_live(&self.particles) {
                 // The partner changed course: a marker. Predict the owner again, from the
@@ -695,7 +713,7 @@ impl<const D: usize> Simulation<D> {
                 self.counts.stale += 1;
                 let guess = self.timing.begin(&self.reading(), owner, None);
                 self.predict_one(owner, guess);
-                continue;
+                return Taken::Bookkeeping;
             }
             self.time = next.time;
             let (Some(a), b) = next.involved(owner) else { unreachable!("an event of a particle") };
@@ -724,13 +742,17 @@ impl<const D: usize> Simulation<D> {
             if after == AfterCollision::Stalled {
                 self.finish_growth(next.time, Ending::Stalled);
             } else if after == AfterCollision::Rescaled || self.wrapped(&outcome) {
+                self.tell_changes(&outcome);
                 self.predict_everyone();
+                self.tell_everyone();
+            } else if self.region.is_some() {
+                self.predict_divided(&outcome, guess);
             } else if let Some(b) = b {
                 self.predict_partners(a, b, guess);
             } else {
                 self.predict_one(a, guess);
             }
-            return Some(outcome);
+            Taken::Event(outcome)
         }
     }
 
@@ -863,10 +885,25 @@ impl<const D: usize> Simulation<D> {
     #[inline(never)]
     fn predict_everyone(&mut self) {
         for k in 0..self.particles.len() {
-            self.predict(k);
+            if self.owns(k) {
+                self.predict(k);
+            } else {
+                self.queue.set(k, Event::NOTHING);
+            }
         }
         self.queue.refit();
     }
+}
+
+/// What one item of the queue came to ([`Simulation::take`]).
+enum Taken<const D: usize> {
+    /// An event, resolved.
+    Event(Outcome<D>),
+    /// Bookkeeping that no observer sees: a re-prediction marker, the neighbourhood rebuilt
+    /// while growing.
+    Bookkeeping,
+    /// Nothing can happen any more.
+    End,
 }
 
 /// The queue structure `params` ask for with `n` particles.
@@ -878,5 +915,6 @@ fn queue_kind(params: &EngineParams, n: usize) -> QueueKind {
     }
 }
 
+pub mod divided;
 #[cfg(test)]
 mod tests;

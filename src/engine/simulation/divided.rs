@@ -1,0 +1,332 @@
+//! The box divided between two slabs across the first axis: [`Divided`], two
+//! [`Simulation`]s that each resolve the events of their own particles and tell each other
+//! what changed — the engine's layout for two cores, here run by one thread in the global
+//! order of events, so that it gives the whole box's events bit for bit.
+//!
+//! # The division
+//!
+//! A particle belongs to the slab (`x < L₀/2`, the lower; else the upper) that held it at its
+//! last neighbourhood update — the centre of its list, or where it entered its cell — so it
+//! changes side only at an event of its own. Each side keeps a replica of every particle,
+//! the whole neighbourhood and a queue in which only its own particles hold events (the
+//! others [`Event::NOTHING`]). A side resolves its own particles' events exactly as the
+//! whole box's engine does: a collision with the other side's particle changes both in its
+//! replica, and it predicts again only its own.
+//!
+//! # What the sides tell each other
+//!
+//! After each event the side that resolved it sends a change per particle it changed:
+//! its new state and the partner its prediction skips (the whole box's engine predicts the
+//! lower particle of a pair skipping the higher, the higher skipping none), a neighbourhood
+//! update, or every particle predicted again (an event counter wrapped). The other side
+//! applies all of an event's changes, then predicts those of its own particles among them
+//! with the skips given — at the event's time, as the whole box's engine does. A particle
+//! whose neighbourhood update takes it into the other slab is given away: its slot emptied
+//! on one side, predicted on the other.
+//!
+//! [`Divided::step`] takes the side whose earliest item (event or re-prediction marker)
+//! comes first in the [total order](crate::engine::sources#the-total-order) and delivers its
+//! changes before the next item, so every prediction reads the states the whole box's engine
+//! reads: the same events, the same markers, the same counts. Every change is sent, so the
+//! replicas stay equal; what a side needs of the other's is the particles near the border.
+//!
+//! # Example
+//!
+//! ```
+//! use collide::engine::{Divided, Simulation};
+//!
+//! let (particles, sim_box) =
+//!     collide::bench::state::initial_state::<3>(500, 0.4, 3).expect("a start");
+//! let mut whole = Simulation::new(particles.clone(), sim_box.clone()).expect("valid");
+//! let mut divided = Divided::new(particles, sim_box).expect("valid");
+//! for _ in 0..2000 {
+//!     assert_eq!(whole.step(), divided.step());
+//! }
+//! assert_eq!(whole.counts(), divided.counts());
+//! ```
+
+use super::{Simulation, Taken};
+use crate::engine::geometry::{Particle, SimBox};
+use crate::engine::params::EngineParams;
+use crate::engine::setup::SetupError;
+use crate::engine::sources::{self, Event, EventCounts, Outcome};
+
+/// One side's view of the division: its slab, every particle's side and what it has still
+/// to tell the other side.
+#[derive(Clone, Debug)]
+pub(crate) struct Region<const D: usize> {
+    side: Side,
+    /// Each particle's side.
+    owner: Vec<Side>,
+    /// Where the slabs meet on the first axis, `L₀/2` (and at 0 ≡ `L₀`).
+    half: f64,
+    /// The changes of the last event, not yet delivered.
+    outbox: Vec<Change<D>>,
+}
+
+/// A slab.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Side {
+    /// `0 ≤ x < L₀/2`.
+    Lower,
+    /// `L₀/2 ≤ x < L₀`.
+    Upper,
+}
+
+impl Side {
+    /// The slab holding first coordinate `x` (wrapped into the box).
+    fn of(x: f64, half: f64) -> Side {
+        if x.rem_euclid(2.0 * half) < half { Side::Lower } else { Side::Upper }
+    }
+}
+
+/// What one side tells the other after an event of its own.
+#[derive(Clone, Debug)]
+pub(crate) struct Change<const D: usize> {
+    /// The event's time.
+    time: f64,
+    what: What<D>,
+}
+
+#[derive(Clone, Debug)]
+enum What<const D: usize> {
+    /// Particle `k` changed course: its new state; predicted again skipping `skip` (itself:
+    /// skipping none).
+    Course { k: u32, state: Particle<D>, skip: u32 },
+    /// Particle `k`'s neighbourhood was updated (its list built again around it, or it
+    /// moved to the next cell).
+    Neighbourhood { k: u32 },
+    /// Every particle was predicted again (an event counter wrapped to 0).
+    Everyone,
+}
+
+impl<const D: usize> Region<D> {
+    fn new(side: Side, particles: &[Particle<D>], sim_box: &SimBox<D>, centres: impl Fn(usize) -> f64) -> Self {
+        let half = 0.5 * sim_box.lengths[0];
+        Region {
+            side,
+            owner: (0..particles.len()).map(|k| Side::of(centres(k), half)).collect(),
+            half,
+            outbox: Vec::new(),
+        }
+    }
+}
+
+impl<const D: usize> Simulation<D> {
+    /// Whether particle `k` is this side's (always, for the whole box).
+    #[inline(always)]
+    pub(super) fn owns(&self, k: usize) -> bool {
+        self.region.as_ref().is_none_or(|r| r.owner[k] == r.side)
+    }
+
+    /// The side of particle `k` by the first coordinate of its neighbourhood's centre: its
+    /// position now, just after its update.
+    fn side_now(&self, k: usize, half: f64) -> Side {
+        Side::of(self.particles[k].position_at(self.time)[0], half)
+    }
+
+    fn tell(&mut self, what: What<D>) {
+        let time = self.time;
+        if let Some(region) = self.region.as_mut() {
+            region.outbox.push(Change { time, what });
+        }
+    }
+
+    /// Tells the other side what an event of this side changed (nothing, for the whole box).
+    pub(super) fn tell_changes(&mut self, outcome: &Outcome<D>) {
+        if self.region.is_none() {
+            return;
+        }
+        let course = |sim: &Self, k: usize, skip: usize| What::Course {
+            k: k as u32,
+            state: sim.particles[k].clone(),
+            skip: skip as u32,
+        };
+        match *outcome {
+            Outcome::Pair { i, j, .. } => {
+                self.tell(course(self, i, j));
+                self.tell(course(self, j, j));
+            }
+            Outcome::Wall { i, .. } => self.tell(course(self, i, i)),
+            Outcome::Rebuild { i } => self.tell(What::Neighbourhood { k: i as u32 }),
+            Outcome::Sample | Outcome::GrowthEnd => unreachable!("a divided box neither samples nor grows"),
+        }
+    }
+
+    /// After an event of this side: tells the other side what changed and predicts this
+    /// side's particles again (a particle that left the slab is given away).
+    pub(super) fn predict_divided(&mut self, outcome: &Outcome<D>, guess: Option<usize>) {
+        self.tell_changes(outcome);
+        match *outcome {
+            Outcome::Pair { i, j, .. } => match (self.owns(i), self.owns(j)) {
+                (true, true) => self.predict_partners(i, j, guess),
+                (true, false) => self.predict_skipping(i, j),
+                (false, true) => self.predict_skipping(j, j),
+                (false, false) => unreachable!("a side resolves only its own particles' events"),
+            },
+            Outcome::Wall { i, .. } => self.predict_one(i, guess),
+            Outcome::Rebuild { i } => {
+                let region = self.region.as_deref().expect("divided");
+                let now = self.side_now(i, region.half);
+                if now == region.side {
+                    self.predict_one(i, guess);
+                } else {
+                    self.region.as_deref_mut().expect("divided").owner[i] = now;
+                    self.queue.set(i, Event::NOTHING);
+                }
+            }
+            Outcome::Sample | Outcome::GrowthEnd => unreachable!("a divided box neither samples nor grows"),
+        }
+    }
+
+    /// Tells the other side that every particle was predicted again.
+    pub(super) fn tell_everyone(&mut self) {
+        self.tell(What::Everyone);
+    }
+
+    /// Predicts particle `i` again, skipping `skip` (itself: none).
+    fn predict_skipping(&mut self, i: usize, skip: usize) {
+        let mut near = [0u32; crate::engine::search::NEAR];
+        let gathered = self.search.gather(&self.neighbours, i, skip, &mut near);
+        self.predict_among(i, skip, &near, gathered);
+    }
+
+    /// Applies the other side's changes of one event: every state first, then the
+    /// predictions of this side's particles among them (and of a particle that entered the
+    /// slab).
+    fn receive(&mut self, changes: &[Change<D>]) {
+        let Some(first) = changes.first() else { return };
+        self.time = first.time;
+        for change in changes {
+            match change.what {
+                What::Course { k, ref state, .. } => self.particles[k as usize] = state.clone(),
+                What::Neighbourhood { k } => {
+                    let k = k as usize;
+                    sources::neighbourhood::resolve(&mut self.neighbours, k, &self.particles[k], self.time);
+                }
+                What::Everyone => {}
+            }
+        }
+        for change in changes {
+            match change.what {
+                What::Course { k, skip, .. } => {
+                    if self.owns(k as usize) {
+                        self.predict_skipping(k as usize, skip as usize);
+                    }
+                }
+                What::Neighbourhood { k } => {
+                    let k = k as usize;
+                    let region = self.region.as_deref().expect("divided");
+                    let now = self.side_now(k, region.half);
+                    if now == region.side {
+                        self.region.as_deref_mut().expect("divided").owner[k] = now;
+                        self.predict_skipping(k, k);
+                    }
+                }
+                What::Everyone => self.predict_everyone(),
+            }
+        }
+    }
+
+    /// The earliest item of this side's queue: its owner and the event.
+    fn earliest(&mut self) -> (u32, Event) {
+        let (owner, event) = self.queue.first();
+        (owner as u32, event)
+    }
+}
+
+/// The box divided between two slabs, run in one thread in the global order of events:
+/// the same events as [`Simulation`], bit for bit (see the [module](self)).
+#[derive(Clone, Debug)]
+pub struct Divided<const D: usize> {
+    sides: [Simulation<D>; 2],
+    /// The changes in delivery (kept to reuse the allocation).
+    mail: Vec<Change<D>>,
+}
+
+impl<const D: usize> Divided<D> {
+    /// Validates the particles and the box (as [`Simulation::new`]) and divides them.
+    pub fn new(particles: Vec<Particle<D>>, sim_box: SimBox<D>) -> Result<Self, SetupError> {
+        Self::with_params(particles, sim_box, EngineParams::default())
+    }
+
+    /// [`new`](Self::new) with the engine's tunables chosen (each side takes them).
+    pub fn with_params(
+        particles: Vec<Particle<D>>,
+        sim_box: SimBox<D>,
+        params: EngineParams,
+    ) -> Result<Self, SetupError> {
+        let whole = Simulation::with_params(particles, sim_box, params)?;
+        let side = |side: Side| {
+            let mut sim = whole.clone();
+            let time = sim.time;
+            let region = Region::new(side, &sim.particles, &sim.sim_box, |k| whole.particles[k].position_at(time)[0]);
+            sim.region = Some(Box::new(region));
+            sim.predict_everyone();
+            sim
+        };
+        Ok(Divided { sides: [side(Side::Lower), side(Side::Upper)], mail: Vec::new() })
+    }
+
+    /// Processes the next event and reports it; `None` when nothing can happen any more.
+    pub fn step(&mut self) -> Option<Outcome<D>> {
+        loop {
+            let ([a, b], [first_a, first_b]) = {
+                let (a, ea) = self.sides[0].earliest();
+                let (b, eb) = self.sides[1].earliest();
+                ([a, b], [ea, eb])
+            };
+            let s = first_b.before(b, &first_a, a) as usize;
+            let taken = self.sides[s].take();
+            let region = self.sides[s].region.as_deref_mut().expect("divided");
+            std::mem::swap(&mut self.mail, &mut region.outbox);
+            self.sides[1 - s].receive(&self.mail);
+            self.mail.clear();
+            match taken {
+                Taken::Event(outcome) => return Some(outcome),
+                Taken::Bookkeeping => continue,
+                Taken::End => return None,
+            }
+        }
+    }
+
+    /// The clock: the time of the last event.
+    pub fn time(&self) -> f64 {
+        self.sides[0].time.max(self.sides[1].time)
+    }
+
+    /// The particles (each side's replica holds them all, equal).
+    pub fn particles(&self) -> &[Particle<D>] {
+        &self.sides[0].particles
+    }
+
+    /// How many particles each side holds now, lower then upper.
+    pub fn sides(&self) -> [usize; 2] {
+        let owner = &self.sides[0].region.as_deref().expect("divided").owner;
+        let upper = owner.iter().filter(|&&s| s == Side::Upper).count();
+        [owner.len() - upper, upper]
+    }
+
+    /// Events so far, both sides'.
+    pub fn counts(&self) -> EventCounts {
+        let [a, b] = [self.sides[0].counts, self.sides[1].counts];
+        EventCounts {
+            pair: a.pair + b.pair,
+            wall: a.wall + b.wall,
+            rebuild: a.rebuild + b.rebuild,
+            sample: a.sample + b.sample,
+            stale: a.stale + b.stale,
+        }
+    }
+
+    /// Whether the two replicas hold the same particles and agree on every particle's side
+    /// (a check for tests).
+    pub fn replicas_agree(&self) -> bool {
+        let [a, b] = &self.sides;
+        let owners = |s: &Simulation<D>| s.region.as_deref().expect("divided").owner.clone();
+        a.particles.iter().zip(&b.particles).all(|(p, q)| p == q) && owners(a) == owners(b)
+    }
+}
+
+#[cfg(test)]
+mod tests;

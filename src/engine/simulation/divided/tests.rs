@@ -1,0 +1,69 @@
+//! The divided box against the whole box: the same events, markers and counts, bit for
+//! bit, with particles crossing between the slabs — in 2D and 3D, periodic and walled, one
+//! size and a mixture, with lists and with the grid.
+
+use super::*;
+use crate::engine::init::{Placement, Species, Velocities, box_for_packing_fraction, initial_particles};
+use crate::engine::{Boundary, Neighbourhood};
+
+/// Runs `steps` events of the whole box and the divided one side by side: every outcome
+/// equal, then the counts (re-prediction markers included) and the particles; the
+/// replicas agree; both slabs hold particles, and some changed side. Returns how many did.
+fn same_events<const D: usize>(
+    particles: Vec<Particle<D>>,
+    sim_box: SimBox<D>,
+    neighbourhood: Neighbourhood,
+    steps: u64,
+) -> usize {
+    let params = EngineParams::with_neighbourhood(neighbourhood);
+    let mut whole = Simulation::with_params(particles.clone(), sim_box.clone(), params).expect("a valid start");
+    let mut divided = Divided::with_params(particles, sim_box, params).expect("a valid start");
+    let start = divided.sides[0].region.as_deref().expect("divided").owner.clone();
+    assert!(divided.sides().iter().all(|&n| n > 0), "{:?}", divided.sides());
+    for k in 0..steps {
+        let (a, b) = (whole.step(), divided.step());
+        assert_eq!(a, b, "event {k}");
+        assert!(a.is_some(), "events go on");
+    }
+    assert_eq!(whole.counts(), divided.counts());
+    assert!(whole.counts().stale > 0, "markers were exercised");
+    assert_eq!(whole.particles(), divided.particles());
+    assert_eq!(whole.time(), divided.time());
+    assert!(divided.replicas_agree());
+    let end = &divided.sides[1].region.as_deref().expect("divided").owner;
+    let moved = start.iter().zip(end).filter(|(a, b)| a != b).count();
+    assert!(moved > 0, "no particle changed side");
+    moved
+}
+
+fn bench_start<const D: usize>(n: usize, eta: f64) -> (Vec<Particle<D>>, SimBox<D>) {
+    crate::bench::state::initial_state::<D>(n, eta, 5).expect("a benchmark start")
+}
+
+#[test]
+fn spheres_at_the_benchmark_density() {
+    for neighbourhood in [Neighbourhood::Lists, Neighbourhood::Grid] {
+        let (particles, sim_box) = bench_start::<3>(2048, 0.45);
+        same_events(particles, sim_box, neighbourhood, 200_000);
+    }
+}
+
+#[test]
+fn dense_disks() {
+    for neighbourhood in [Neighbourhood::Lists, Neighbourhood::Grid] {
+        let (particles, sim_box) = bench_start::<2>(2000, 0.65);
+        same_events(particles, sim_box, neighbourhood, 200_000);
+    }
+}
+
+/// Walls on every axis (so on the axis divided) and two species of unequal size and mass.
+#[test]
+fn walled_mixtures() {
+    let species = [Species { count: 300, radius: 0.5, mass: 1.0 }, Species { count: 200, radius: 0.3, mass: 0.4 }];
+    let sim_box = box_for_packing_fraction::<3>(&species, 0.3, [Boundary::Wall; 3], Placement::Random, None);
+    let particles = initial_particles(&species, &sim_box, Placement::Random, Velocities::Maxwell, 1.0, 4).unwrap();
+    same_events(particles, sim_box, Neighbourhood::Lists, 100_000);
+    let sim_box = box_for_packing_fraction::<2>(&species, 0.5, [Boundary::Wall; 2], Placement::Random, None);
+    let particles = initial_particles(&species, &sim_box, Placement::Random, Velocities::Maxwell, 1.0, 4).unwrap();
+    same_events(particles, sim_box, Neighbourhood::Grid, 100_000);
+}
