@@ -46,7 +46,7 @@
 //! ```
 
 use super::{Simulation, Taken};
-use crate::engine::geometry::{Particle, SimBox};
+use crate::engine::geometry::{Boundary, Particle, SimBox};
 use crate::engine::params::EngineParams;
 use crate::engine::setup::SetupError;
 use crate::engine::sources::{self, Event, EventCounts, Outcome};
@@ -58,8 +58,15 @@ pub(crate) struct Region<const D: usize> {
     side: Side,
     /// Each particle's side.
     owner: Vec<Side>,
-    /// Where the slabs meet on the first axis, `L₀/2` (and at 0 ≡ `L₀`).
+    /// Each particle's anchor: the first coordinate of where it last updated its
+    /// neighbourhood (wrapped into the box), which says its side and whether it is near.
+    anchor: Vec<f64>,
+    /// Where the slabs meet on the first axis, `L₀/2` (and at 0 ≡ `L₀` when periodic).
     half: f64,
+    periodic: bool,
+    /// How far from a border an anchor is *near*: within the reach of the other side's
+    /// reads (the neighbourhood's `read_reach`).
+    zone: f64,
     /// The changes of the last event, not yet delivered.
     outbox: Vec<Change<D>>,
 }
@@ -94,22 +101,55 @@ enum What<const D: usize> {
     /// skipping none).
     Course { k: u32, state: Particle<D>, skip: u32 },
     /// Particle `k`'s neighbourhood was updated (its list built again around it, or it
-    /// moved to the next cell).
-    Neighbourhood { k: u32 },
+    /// moved to the next cell); its state, which the other side may not have.
+    Neighbourhood { k: u32, state: Particle<D> },
     /// Every particle was predicted again (an event counter wrapped to 0).
     Everyone,
 }
 
 impl<const D: usize> Region<D> {
-    fn new(side: Side, particles: &[Particle<D>], sim_box: &SimBox<D>, centres: impl Fn(usize) -> f64) -> Self {
+    fn new(side: Side, sim_box: &SimBox<D>, anchors: Vec<f64>, zone: f64) -> Self {
         let half = 0.5 * sim_box.lengths[0];
+        let anchor: Vec<f64> = anchors.into_iter().map(|x| x.rem_euclid(2.0 * half)).collect();
         Region {
             side,
-            owner: (0..particles.len()).map(|k| Side::of(centres(k), half)).collect(),
+            owner: anchor.iter().map(|&x| Side::of(x, half)).collect(),
+            anchor,
             half,
+            periodic: sim_box.boundary[0] == Boundary::Periodic,
+            zone,
             outbox: Vec::new(),
         }
     }
+
+    /// Whether particle `k`'s anchor is near a border: the other side may read its state.
+    fn near(&self, k: usize) -> bool {
+        let x = self.anchor[k];
+        let to_border =
+            if self.periodic { (x - self.half).abs().min(x).min(2.0 * self.half - x) } else { (x - self.half).abs() };
+        to_border < self.zone
+    }
+
+    /// Moves particle `k`'s anchor to `x` (where it updated its neighbourhood): its side
+    /// now, which it takes.
+    fn anchor_at(&mut self, k: usize, x: f64) -> Side {
+        self.anchor[k] = x.rem_euclid(2.0 * self.half);
+        self.owner[k] = Side::of(self.anchor[k], self.half);
+        self.owner[k]
+    }
+}
+
+/// What a side holds of a particle of the other side that is not near: nothing it may read.
+/// Its motion is not a number, so that a read shows at once (the tests fail within a few
+/// thousand events when the zone is made narrower than the reads reach). Its counter is
+/// the last one known with the top bit flipped, so that an event of this side with it as
+/// partner is a re-prediction marker — as it is in the whole box: a live pair event's
+/// partner stays near on its way to the contact, so one that got far changed course on the
+/// way, where it was near and this side was told. The flip only makes sure.
+fn poisoned<const D: usize>(p: &mut Particle<D>) {
+    p.position.fill(f64::NAN);
+    p.velocity.fill(f64::NAN);
+    p.events ^= 1 << 31;
 }
 
 impl<const D: usize> Simulation<D> {
@@ -119,15 +159,25 @@ impl<const D: usize> Simulation<D> {
         self.region.as_ref().is_none_or(|r| r.owner[k] == r.side)
     }
 
-    /// The side of particle `k` by the first coordinate of its neighbourhood's centre: its
-    /// position now, just after its update.
-    fn side_now(&self, k: usize, half: f64) -> Side {
-        Side::of(self.particles[k].position_at(self.time)[0], half)
+    /// Particle `k` updated its neighbourhood now: its anchor moves where it is, and the
+    /// side it takes is returned.
+    fn anchor_now(&mut self, k: usize) -> Side {
+        let x = self.particles[k].position_at(self.time)[0];
+        self.region.as_deref_mut().expect("divided").anchor_at(k, x)
     }
 
+    /// Queues a change for the other side: always a neighbourhood update or every particle
+    /// predicted; a new course of the other side's particle, or of one of this side's near a
+    /// border.
     fn tell(&mut self, what: What<D>) {
         let time = self.time;
         if let Some(region) = self.region.as_mut() {
+            if let What::Course { k, .. } = what
+                && region.owner[k as usize] == region.side
+                && !region.near(k as usize)
+            {
+                return;
+            }
             region.outbox.push(Change { time, what });
         }
     }
@@ -148,7 +198,7 @@ impl<const D: usize> Simulation<D> {
                 self.tell(course(self, j, j));
             }
             Outcome::Wall { i, .. } => self.tell(course(self, i, i)),
-            Outcome::Rebuild { i } => self.tell(What::Neighbourhood { k: i as u32 }),
+            Outcome::Rebuild { i } => self.tell(What::Neighbourhood { k: i as u32, state: self.particles[i].clone() }),
             Outcome::Sample | Outcome::GrowthEnd => unreachable!("a divided box neither samples nor grows"),
         }
     }
@@ -166,12 +216,9 @@ impl<const D: usize> Simulation<D> {
             },
             Outcome::Wall { i, .. } => self.predict_one(i, guess),
             Outcome::Rebuild { i } => {
-                let region = self.region.as_deref().expect("divided");
-                let now = self.side_now(i, region.half);
-                if now == region.side {
+                if self.anchor_now(i) == self.region.as_deref().expect("divided").side {
                     self.predict_one(i, guess);
                 } else {
-                    self.region.as_deref_mut().expect("divided").owner[i] = now;
                     self.queue.set(i, Event::NOTHING);
                 }
             }
@@ -200,8 +247,9 @@ impl<const D: usize> Simulation<D> {
         for change in changes {
             match change.what {
                 What::Course { k, ref state, .. } => self.particles[k as usize] = state.clone(),
-                What::Neighbourhood { k } => {
+                What::Neighbourhood { k, ref state } => {
                     let k = k as usize;
+                    self.particles[k] = state.clone();
                     sources::neighbourhood::resolve(&mut self.neighbours, k, &self.particles[k], self.time);
                 }
                 What::Everyone => {}
@@ -214,13 +262,14 @@ impl<const D: usize> Simulation<D> {
                         self.predict_skipping(k as usize, skip as usize);
                     }
                 }
-                What::Neighbourhood { k } => {
+                What::Neighbourhood { k, .. } => {
                     let k = k as usize;
+                    let side = self.anchor_now(k);
                     let region = self.region.as_deref().expect("divided");
-                    let now = self.side_now(k, region.half);
-                    if now == region.side {
-                        self.region.as_deref_mut().expect("divided").owner[k] = now;
+                    if side == region.side {
                         self.predict_skipping(k, k);
+                    } else if !region.near(k) {
+                        poisoned(&mut self.particles[k]);
                     }
                 }
                 What::Everyone => self.predict_everyone(),
@@ -257,10 +306,17 @@ impl<const D: usize> Divided<D> {
         params: EngineParams,
     ) -> Result<Self, SetupError> {
         let whole = Simulation::with_params(particles, sim_box, params)?;
+        let time = whole.time;
+        let anchors = || whole.particles.iter().map(|p| p.position_at(time)[0]).collect();
+        let zone = whole.neighbours.read_reach(0);
         let side = |side: Side| {
             let mut sim = whole.clone();
-            let time = sim.time;
-            let region = Region::new(side, &sim.particles, &sim.sim_box, |k| whole.particles[k].position_at(time)[0]);
+            let region = Region::new(side, &sim.sim_box, anchors(), zone);
+            for (k, p) in sim.particles.iter_mut().enumerate() {
+                if region.owner[k] != side && !region.near(k) {
+                    poisoned(p);
+                }
+            }
             sim.region = Some(Box::new(region));
             sim.predict_everyone();
             sim
@@ -295,9 +351,10 @@ impl<const D: usize> Divided<D> {
         self.sides[0].time.max(self.sides[1].time)
     }
 
-    /// The particles (each side's replica holds them all, equal).
-    pub fn particles(&self) -> &[Particle<D>] {
-        &self.sides[0].particles
+    /// The particles, each from its side.
+    pub fn particles(&self) -> Vec<Particle<D>> {
+        let owner = &self.sides[0].region.as_deref().expect("divided").owner;
+        owner.iter().enumerate().map(|(k, s)| self.sides[*s as usize].particles[k].clone()).collect()
     }
 
     /// How many particles each side holds now, lower then upper.
@@ -319,12 +376,22 @@ impl<const D: usize> Divided<D> {
         }
     }
 
-    /// Whether the two replicas hold the same particles and agree on every particle's side
-    /// (a check for tests).
+    /// Whether the two sides agree on every particle's side and anchor, and each holds the
+    /// state of every particle of the other's that is near a border (a check for tests).
     pub fn replicas_agree(&self) -> bool {
         let [a, b] = &self.sides;
-        let owners = |s: &Simulation<D>| s.region.as_deref().expect("divided").owner.clone();
-        a.particles.iter().zip(&b.particles).all(|(p, q)| p == q) && owners(a) == owners(b)
+        let (ra, rb) = (a.region.as_deref().expect("divided"), b.region.as_deref().expect("divided"));
+        let near_equal = (0..a.particles.len()).filter(|&k| ra.near(k)).all(|k| a.particles[k] == b.particles[k]);
+        ra.owner == rb.owner && ra.anchor == rb.anchor && near_equal
+    }
+
+    /// How many of the other side's particles each side holds the state of (those near a
+    /// border), the lower side's count first.
+    pub fn known(&self) -> [usize; 2] {
+        self.sides.each_ref().map(|s| {
+            let region = s.region.as_deref().expect("divided");
+            (0..s.particles.len()).filter(|&k| region.owner[k] != region.side && region.near(k)).count()
+        })
     }
 }
 
