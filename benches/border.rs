@@ -35,6 +35,10 @@
 //! keeps. A rebuild changes no course but the lists around its sphere, which the events of
 //! the spheres around it read next: it counts as a change of its sphere.
 //!
+//! First, per size, the engine's own division ([`Divided`]) run in one thread beside the
+//! whole box: the changes its sides tell each other per event, the share of the other
+//! side's particles each holds, and its time per event against the whole box's.
+//!
 //! ```text
 //! cargo bench --bench border                          # N = 10 976 and 97 556, 10⁶ events each
 //! cargo bench --bench border -- 10976 --events 2000000
@@ -43,7 +47,7 @@
 //! With `--test` (as `cargo bench -- --test` runs every bench) it checks the schedule on
 //! cases with known answers and replays a small system.
 
-use collide::engine::{Outcome, RANGE_HOLDS_3D, SimBox, Simulation};
+use collide::engine::{Divided, Outcome, RANGE_HOLDS_3D, SimBox, Simulation};
 use nalgebra::Vector3;
 
 /// Packing fraction of the replayed fluid.
@@ -354,7 +358,47 @@ fn replay(n: usize, events: u64) -> (Vec<Schedule>, Traffic) {
     (schedules, traffic)
 }
 
+/// The engine's own division ([`Divided`]), run in one thread beside the whole box from the
+/// same warmed-up state: the changes the sides tell each other per event, the share of the
+/// other side's particles each holds, and the time per event against the whole box's
+/// (both in this process, alternated in blocks of 10⁵ events).
+fn divided(n: usize, events: u64) {
+    let (particles, sim_box) = collide::bench::state::initial_state::<3>(n, ETA, 1).expect("a benchmark start");
+    let mut sim = Simulation::new(particles, sim_box.clone()).expect("a valid start");
+    while sim.counts().pair < collide::bench::WARMUP * n as u64 {
+        sim.step().expect("events go on");
+    }
+    let start: Vec<_> = sim.particles().to_vec();
+    let mut whole = Simulation::new(start.clone(), sim_box.clone()).expect("a valid start");
+    let mut divided = Divided::new(start, sim_box).expect("a valid start");
+    let (mut t_whole, mut t_divided, mut done) = (0.0, 0.0, 0);
+    while done < events {
+        let block = 100_000.min(events - done);
+        let clock = std::time::Instant::now();
+        for _ in 0..block {
+            whole.step().expect("events go on");
+        }
+        t_whole += clock.elapsed().as_secs_f64();
+        let clock = std::time::Instant::now();
+        for _ in 0..block {
+            divided.step().expect("events go on");
+        }
+        t_divided += clock.elapsed().as_secs_f64();
+        done += block;
+    }
+    assert_eq!(whole.counts(), divided.counts(), "the divided box's events differ from the whole box's");
+    let (known, sides) = (divided.known(), divided.sides());
+    println!(
+        "divided, one thread: {:.3} changes told per event; each side holds {:.2} and {:.2} of the other's particles; time per event {:.3} of the whole box's",
+        divided.told() as f64 / events as f64,
+        known[0] as f64 / sides[1] as f64,
+        known[1] as f64 / sides[0] as f64,
+        t_divided / t_whole
+    );
+}
+
 fn report(n: usize, events: u64) {
+    divided(n, events);
     let (schedules, traffic) = replay(n, events);
     let (range, skin) = range_and_skin();
     println!(

@@ -69,6 +69,8 @@ pub(crate) struct Region<const D: usize> {
     zone: f64,
     /// The changes of the last event, not yet delivered.
     outbox: Vec<Change<D>>,
+    /// Changes told so far.
+    told: u64,
 }
 
 /// A slab.
@@ -119,6 +121,7 @@ impl<const D: usize> Region<D> {
             periodic: sim_box.boundary[0] == Boundary::Periodic,
             zone,
             outbox: Vec::new(),
+            told: 0,
         }
     }
 
@@ -166,19 +169,21 @@ impl<const D: usize> Simulation<D> {
         self.region.as_deref_mut().expect("divided").anchor_at(k, x)
     }
 
-    /// Queues a change for the other side: always a neighbourhood update or every particle
-    /// predicted; a new course of the other side's particle, or of one of this side's near a
-    /// border.
-    fn tell(&mut self, what: What<D>) {
+    /// Queues a change for the other side: a new course of the other side's particle, or of
+    /// one of this side's near a border; a neighbourhood update if `told` (one that starts or
+    /// ends near; with the grid, every one); every particle predicted again.
+    fn tell(&mut self, what: What<D>, told: bool) {
         let time = self.time;
         if let Some(region) = self.region.as_mut() {
-            if let What::Course { k, .. } = what
-                && region.owner[k as usize] == region.side
-                && !region.near(k as usize)
-            {
-                return;
+            let told = match what {
+                What::Course { k, .. } => region.owner[k as usize] != region.side || region.near(k as usize),
+                What::Neighbourhood { .. } => told,
+                What::Everyone => true,
+            };
+            if told {
+                region.told += 1;
+                region.outbox.push(Change { time, what });
             }
-            region.outbox.push(Change { time, what });
         }
     }
 
@@ -194,11 +199,12 @@ impl<const D: usize> Simulation<D> {
         };
         match *outcome {
             Outcome::Pair { i, j, .. } => {
-                self.tell(course(self, i, j));
-                self.tell(course(self, j, j));
+                self.tell(course(self, i, j), false);
+                self.tell(course(self, j, j), false);
             }
-            Outcome::Wall { i, .. } => self.tell(course(self, i, i)),
-            Outcome::Rebuild { i } => self.tell(What::Neighbourhood { k: i as u32, state: self.particles[i].clone() }),
+            Outcome::Wall { i, .. } => self.tell(course(self, i, i), false),
+            // Told where the anchor is known, before and after (`predict_divided`).
+            Outcome::Rebuild { .. } => {}
             Outcome::Sample | Outcome::GrowthEnd => unreachable!("a divided box neither samples nor grows"),
         }
     }
@@ -216,7 +222,14 @@ impl<const D: usize> Simulation<D> {
             },
             Outcome::Wall { i, .. } => self.predict_one(i, guess),
             Outcome::Rebuild { i } => {
-                if self.anchor_now(i) == self.region.as_deref().expect("divided").side {
+                let was_near = self.region.as_deref().expect("divided").near(i);
+                let side = self.anchor_now(i);
+                let near = self.region.as_deref().expect("divided").near(i);
+                // The grid moves a particle one cell from where the replica has it: every move
+                // is told. A list is centred where the particle is: only near ones are.
+                let told = was_near || near || !self.neighbours.listed();
+                self.tell(What::Neighbourhood { k: i as u32, state: self.particles[i].clone() }, told);
+                if side == self.region.as_deref().expect("divided").side {
                     self.predict_one(i, guess);
                 } else {
                     self.queue.set(i, Event::NOTHING);
@@ -228,7 +241,7 @@ impl<const D: usize> Simulation<D> {
 
     /// Tells the other side that every particle was predicted again.
     pub(super) fn tell_everyone(&mut self) {
-        self.tell(What::Everyone);
+        self.tell(What::Everyone, true);
     }
 
     /// Predicts particle `i` again, skipping `skip` (itself: none).
@@ -376,13 +389,27 @@ impl<const D: usize> Divided<D> {
         }
     }
 
-    /// Whether the two sides agree on every particle's side and anchor, and each holds the
-    /// state of every particle of the other's that is near a border (a check for tests).
+    /// Whether the two sides agree on every particle's side, and on the anchor and state of
+    /// every particle near a border, and each takes every other particle of the other's to
+    /// be far (a check for tests).
     pub fn replicas_agree(&self) -> bool {
-        let [a, b] = &self.sides;
-        let (ra, rb) = (a.region.as_deref().expect("divided"), b.region.as_deref().expect("divided"));
-        let near_equal = (0..a.particles.len()).filter(|&k| ra.near(k)).all(|k| a.particles[k] == b.particles[k]);
-        ra.owner == rb.owner && ra.anchor == rb.anchor && near_equal
+        let regions = self.sides.each_ref().map(|s| s.region.as_deref().expect("divided"));
+        (0..self.sides[0].particles.len()).all(|k| {
+            let owner = regions[0].owner[k] as usize;
+            let (mine, theirs) = (regions[owner], regions[1 - owner]);
+            mine.owner[k] == theirs.owner[k]
+                && if mine.near(k) {
+                    mine.anchor[k] == theirs.anchor[k]
+                        && self.sides[owner].particles[k] == self.sides[1 - owner].particles[k]
+                } else {
+                    !theirs.near(k)
+                }
+        })
+    }
+
+    /// The changes the sides have told each other so far.
+    pub fn told(&self) -> u64 {
+        self.sides.iter().map(|s| s.region.as_deref().expect("divided").told).sum()
     }
 
     /// How many of the other side's particles each side holds the state of (those near a
