@@ -280,14 +280,20 @@ fn range_and_skin() -> (f64, f64) {
     (range, range - 1.0)
 }
 
-/// Replays `events` events of `n` spheres after the warm-up; one schedule per dependency
-/// notion and hand-over cost.
-fn replay(n: usize, events: u64) -> (Vec<Schedule>, Traffic) {
+/// `n` spheres at `ETA` from the benchmark report's start, warmed up as `collide bench` does.
+fn warmed_up(n: usize) -> Simulation<3> {
     let (particles, sim_box) = collide::bench::state::initial_state::<3>(n, ETA, 1).expect("a benchmark start");
     let mut sim = Simulation::new(particles, sim_box).expect("a valid start");
     while sim.counts().pair < collide::bench::WARMUP * n as u64 {
         sim.step().expect("events go on");
     }
+    sim
+}
+
+/// Replays `events` events of `n` spheres after the warm-up; one schedule per dependency
+/// notion and hand-over cost.
+fn replay(n: usize, events: u64) -> (Vec<Schedule>, Traffic) {
+    let mut sim = warmed_up(n);
     let (range, skin) = range_and_skin();
     let reach = range + skin;
     let half = 0.5 * sim.sim_box().lengths[0];
@@ -363,12 +369,8 @@ fn replay(n: usize, events: u64) -> (Vec<Schedule>, Traffic) {
 /// other side's particles each holds, and the time per event against the whole box's
 /// (both in this process, alternated in blocks of 10⁵ events).
 fn divided(n: usize, events: u64) {
-    let (particles, sim_box) = collide::bench::state::initial_state::<3>(n, ETA, 1).expect("a benchmark start");
-    let mut sim = Simulation::new(particles, sim_box.clone()).expect("a valid start");
-    while sim.counts().pair < collide::bench::WARMUP * n as u64 {
-        sim.step().expect("events go on");
-    }
-    let start: Vec<_> = sim.particles().to_vec();
+    let sim = warmed_up(n);
+    let (start, sim_box) = (sim.particles().to_vec(), sim.sim_box().clone());
     let mut whole = Simulation::new(start.clone(), sim_box.clone()).expect("a valid start");
     let mut divided = Divided::new(start, sim_box).expect("a valid start");
     let (mut t_whole, mut t_divided, mut done) = (0.0, 0.0, 0);

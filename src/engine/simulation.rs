@@ -674,86 +674,84 @@ impl<const D: usize> Simulation<D> {
     /// neighbourhood while growing — and deals with it.
     #[inline(always)]
     fn take(&mut self) -> Taken<D> {
+        let (owner, next) = self.queue.first();
+        let end = self.growth.map(|g| Event { time: g.predict(), kind: EventKind::GrowthEnd });
+        let ends_first = end.is_some_and(|end| end.before(u32::MAX, &next, owner as u32));
+        if let Some(time) = self.sampling.predict()
+            && (Event { time, kind: EventKind::Sample }).before(u32::MAX, &next, owner as u32)
+            && end.is_none_or(|end| (Event { time, kind: EventKind::Sample }).before(u32::MAX, &end, u32::MAX))
         {
-            let (owner, next) = self.queue.first();
-            let end = self.growth.map(|g| Event { time: g.predict(), kind: EventKind::GrowthEnd });
-            let ends_first = end.is_some_and(|end| end.before(u32::MAX, &next, owner as u32));
-            if let Some(time) = self.sampling.predict()
-                && (Event { time, kind: EventKind::Sample }).before(u32::MAX, &next, owner as u32)
-                && end.is_none_or(|end| (Event { time, kind: EventKind::Sample }).before(u32::MAX, &end, u32::MAX))
-            {
-                self.time = time;
-                self.sampling.resolve(time);
-                self.counts.record(&Outcome::<D>::Sample);
-                return Taken::Event(Outcome::Sample);
-            }
-            if ends_first && let Some(growth) = &self.growth {
-                self.finish_growth(growth.predict(), Ending::Reached);
-                return Taken::Event(Outcome::GrowthEnd);
-            }
-            if let Some(t) = self.holds_until
-                && end.is_some_and(|end| t < end.time)
-                && t <= next.time
-                && self.sampling.predict().is_none_or(|sample| t <= sample)
-            {
-                // The radii have grown as far as the neighbourhood holds: rebuilt for the next
-                // stretch. No particle changes, so no event is reported; the pending events
-                // are predicted again against the new neighbourhood (the same events).
-                self.time = t;
-                self.arrange_neighbourhood();
-                self.predict_everyone();
-                return Taken::Bookkeeping;
-            }
-            if next.kind == EventKind::Nothing {
-                return Taken::End;
-            }
-            if !next.is_live(&self.particles) {
-                // The partner changed course: a marker. Predict the owner again, from the
-                // clock of the last real event (the marker is no event).
-                self.counts.stale += 1;
-                let guess = self.timing.begin(&self.reading(), owner, None);
-                self.predict_one(owner, guess);
-                return Taken::Bookkeeping;
-            }
-            self.time = next.time;
-            let (Some(a), b) = next.involved(owner) else { unreachable!("an event of a particle") };
-            let guess = self.timing.begin(&self.reading(), a, b);
-            if next.kind == EventKind::Rebuild {
-                self.timing.leaving(&self.reading(), a, next.time);
-            }
-            let radii = self.radii();
-            let outcome = sources::resolve(
-                &mut self.particles,
-                &self.sim_box,
-                Some(&mut self.neighbours),
-                self.restitution,
-                radii,
-                owner,
-                &next,
-            );
-            self.counts.record(&outcome);
-            let after = match (&mut self.growth, &outcome) {
-                (Some(growth), Outcome::Pair { .. }) => {
-                    let dof = self.sim_box.degrees_of_freedom(self.particles.len());
-                    growth.after_collision(&mut self.particles, next.time, dof)
-                }
-                _ => AfterCollision::Counted,
-            };
-            if after == AfterCollision::Stalled {
-                self.finish_growth(next.time, Ending::Stalled);
-            } else if after == AfterCollision::Rescaled || self.wrapped(&outcome) {
-                self.tell_changes(&outcome);
-                self.predict_everyone();
-                self.tell_everyone();
-            } else if self.region.is_some() {
-                self.predict_divided(&outcome, guess);
-            } else if let Some(b) = b {
-                self.predict_partners(a, b, guess);
-            } else {
-                self.predict_one(a, guess);
-            }
-            Taken::Event(outcome)
+            self.time = time;
+            self.sampling.resolve(time);
+            self.counts.record(&Outcome::<D>::Sample);
+            return Taken::Event(Outcome::Sample);
         }
+        if ends_first && let Some(growth) = &self.growth {
+            self.finish_growth(growth.predict(), Ending::Reached);
+            return Taken::Event(Outcome::GrowthEnd);
+        }
+        if let Some(t) = self.holds_until
+            && end.is_some_and(|end| t < end.time)
+            && t <= next.time
+            && self.sampling.predict().is_none_or(|sample| t <= sample)
+        {
+            // The radii have grown as far as the neighbourhood holds: rebuilt for the next
+            // stretch. No particle changes, so no event is reported; the pending events
+            // are predicted again against the new neighbourhood (the same events).
+            self.time = t;
+            self.arrange_neighbourhood();
+            self.predict_everyone();
+            return Taken::Bookkeeping;
+        }
+        if next.kind == EventKind::Nothing {
+            return Taken::End;
+        }
+        if !next.is_live(&self.particles) {
+            // The partner changed course: a marker. Predict the owner again, from the
+            // clock of the last real event (the marker is no event).
+            self.counts.stale += 1;
+            let guess = self.timing.begin(&self.reading(), owner, None);
+            self.predict_one(owner, guess);
+            return Taken::Bookkeeping;
+        }
+        self.time = next.time;
+        let (Some(a), b) = next.involved(owner) else { unreachable!("an event of a particle") };
+        let guess = self.timing.begin(&self.reading(), a, b);
+        if next.kind == EventKind::Rebuild {
+            self.timing.leaving(&self.reading(), a, next.time);
+        }
+        let radii = self.radii();
+        let outcome = sources::resolve(
+            &mut self.particles,
+            &self.sim_box,
+            Some(&mut self.neighbours),
+            self.restitution,
+            radii,
+            owner,
+            &next,
+        );
+        self.counts.record(&outcome);
+        let after = match (&mut self.growth, &outcome) {
+            (Some(growth), Outcome::Pair { .. }) => {
+                let dof = self.sim_box.degrees_of_freedom(self.particles.len());
+                growth.after_collision(&mut self.particles, next.time, dof)
+            }
+            _ => AfterCollision::Counted,
+        };
+        if after == AfterCollision::Stalled {
+            self.finish_growth(next.time, Ending::Stalled);
+        } else if after == AfterCollision::Rescaled || self.wrapped(&outcome) {
+            self.tell_changes(&outcome);
+            self.predict_everyone();
+            self.tell_everyone();
+        } else if self.region.is_some() {
+            self.predict_divided(&outcome, guess);
+        } else if let Some(b) = b {
+            self.predict_partners(a, b, guess);
+        } else {
+            self.predict_one(a, guess);
+        }
+        Taken::Event(outcome)
     }
 
     /// Whether the event counter of a particle the event moved wrapped to 0 (once per 2³²

@@ -551,11 +551,11 @@ impl<const D: usize> Neighbours<D> {
         listed.chain(grid)
     }
 
-    /// How far along `axis` from where particle `i` last updated its neighbourhood (its
-    /// list's centre, or where it entered its cell) lie the places where the particles its
-    /// predictions read last updated theirs, at most: they are members of its list (centres
-    /// within the range, no wider than a cell) or of the cells around its own, two cell
-    /// widths; a quarter of a width more against rounding at the cells' edges.
+    /// How far along `axis` from where a particle last updated its neighbourhood (its list's
+    /// centre, or where it entered its cell) the particles its predictions read last updated
+    /// theirs, at most: they are members of its list (centres within the range, no wider
+    /// than a cell) or of the cells around its own, two cell widths; a quarter of a width
+    /// more against rounding at the cells' edges.
     pub(crate) fn read_reach(&self, axis: usize) -> f64 {
         2.25 * self.cells.width(axis)
     }

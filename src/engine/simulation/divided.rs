@@ -83,9 +83,9 @@ pub enum Side {
 }
 
 impl Side {
-    /// The slab holding first coordinate `x` (wrapped into the box).
+    /// The slab holding first coordinate `x` (already wrapped into the box).
     fn of(x: f64, half: f64) -> Side {
-        if x.rem_euclid(2.0 * half) < half { Side::Lower } else { Side::Upper }
+        if x < half { Side::Lower } else { Side::Upper }
     }
 }
 
@@ -169,21 +169,20 @@ impl<const D: usize> Simulation<D> {
         self.region.as_deref_mut().expect("divided").anchor_at(k, x)
     }
 
-    /// Queues a change for the other side: a new course of the other side's particle, or of
-    /// one of this side's near a border; a neighbourhood update if `told` (one that starts or
-    /// ends near; with the grid, every one); every particle predicted again.
-    fn tell(&mut self, what: What<D>, told: bool) {
+    /// Queues a change for the other side.
+    fn tell(&mut self, what: What<D>) {
         let time = self.time;
-        if let Some(region) = self.region.as_mut() {
-            let told = match what {
-                What::Course { k, .. } => region.owner[k as usize] != region.side || region.near(k as usize),
-                What::Neighbourhood { .. } => told,
-                What::Everyone => true,
-            };
-            if told {
-                region.told += 1;
-                region.outbox.push(Change { time, what });
-            }
+        let region = self.region.as_deref_mut().expect("divided");
+        region.told += 1;
+        region.outbox.push(Change { time, what });
+    }
+
+    /// Tells particle `k`'s new course, predicted again skipping `skip`, if the other side
+    /// holds it: its own, or this side's near a border.
+    fn tell_course(&mut self, k: usize, skip: usize) {
+        let region = self.region.as_deref().expect("divided");
+        if region.owner[k] != region.side || region.near(k) {
+            self.tell(What::Course { k: k as u32, state: self.particles[k].clone(), skip: skip as u32 });
         }
     }
 
@@ -192,17 +191,12 @@ impl<const D: usize> Simulation<D> {
         if self.region.is_none() {
             return;
         }
-        let course = |sim: &Self, k: usize, skip: usize| What::Course {
-            k: k as u32,
-            state: sim.particles[k].clone(),
-            skip: skip as u32,
-        };
         match *outcome {
             Outcome::Pair { i, j, .. } => {
-                self.tell(course(self, i, j), false);
-                self.tell(course(self, j, j), false);
+                self.tell_course(i, j);
+                self.tell_course(j, j);
             }
-            Outcome::Wall { i, .. } => self.tell(course(self, i, i), false),
+            Outcome::Wall { i, .. } => self.tell_course(i, i),
             // Told where the anchor is known, before and after (`predict_divided`).
             Outcome::Rebuild { .. } => {}
             Outcome::Sample | Outcome::GrowthEnd => unreachable!("a divided box neither samples nor grows"),
@@ -227,8 +221,9 @@ impl<const D: usize> Simulation<D> {
                 let near = self.region.as_deref().expect("divided").near(i);
                 // The grid moves a particle one cell from where the replica has it: every move
                 // is told. A list is centred where the particle is: only near ones are.
-                let told = was_near || near || !self.neighbours.listed();
-                self.tell(What::Neighbourhood { k: i as u32, state: self.particles[i].clone() }, told);
+                if was_near || near || !self.neighbours.listed() {
+                    self.tell(What::Neighbourhood { k: i as u32, state: self.particles[i].clone() });
+                }
                 if side == self.region.as_deref().expect("divided").side {
                     self.predict_one(i, guess);
                 } else {
@@ -241,7 +236,9 @@ impl<const D: usize> Simulation<D> {
 
     /// Tells the other side that every particle was predicted again.
     pub(super) fn tell_everyone(&mut self) {
-        self.tell(What::Everyone, true);
+        if self.region.is_some() {
+            self.tell(What::Everyone);
+        }
     }
 
     /// Predicts particle `i` again, skipping `skip` (itself: none).
