@@ -37,7 +37,11 @@
 //!
 //! First, per size, the engine's own division ([`Divided`]) run in one thread beside the
 //! whole box: the changes its sides tell each other per event, the share of the other
-//! side's particles each holds, and its time per event against the whole box's.
+//! side's particles each holds, and its time per event against the whole box's. Then the
+//! same division in two threads that apply each other's changes on arrival
+//! ([`Divided::run_unordered`], an upper bound on a two-thread engine that keeps the order
+//! of time), against the whole box in five alternated rounds, each followed by the time a
+//! cache line takes from one thread to the other, on which it depends.
 //!
 //! ```text
 //! cargo bench --bench border                          # N = 10 976 and 97 556, 10⁶ events each
@@ -399,8 +403,89 @@ fn divided(n: usize, events: u64) {
     );
 }
 
+/// What a cache line takes to pass from one thread to another, one way, in nanoseconds: a
+/// counter bumped in turn by two threads, 10⁶ times. It says where the two threads run (the
+/// same machine's two cores have measured 25 ns and 200 ns in different hours), on which
+/// the two-thread row depends.
+fn handover_ns() -> f64 {
+    use std::sync::atomic::{AtomicU64, Ordering};
+    const PASSES: u64 = 1_000_000;
+    let counter = AtomicU64::new(0);
+    let bump = |parity: u64| {
+        let mut x = parity;
+        while x < PASSES {
+            while counter.load(Ordering::Acquire) != x {
+                std::hint::spin_loop();
+            }
+            counter.store(x + 1, Ordering::Release);
+            x += 2;
+        }
+    };
+    let clock = std::time::Instant::now();
+    std::thread::scope(|scope| {
+        scope.spawn(|| bump(1));
+        bump(0);
+    });
+    clock.elapsed().as_secs_f64() / PASSES as f64 * 1e9
+}
+
+/// The engine's own division in two threads, each side applying the other's changes as
+/// they arrive ([`Divided::run_unordered`]): its events per second against the whole box's
+/// from the same warmed-up start, in `ROUNDS` rounds alternated in this process (median
+/// ratio and range), and the share of the changes received that arrived in the receiver's
+/// past.
+fn two_threads(n: usize, events: u64) {
+    const ROUNDS: usize = 5;
+    let sim = warmed_up(n);
+    let (start, sim_box) = (sim.particles().to_vec(), *sim.sim_box());
+    let (mut ratios, mut rounds, mut late, mut disowned) = (Vec::new(), Vec::new(), (0, 0), 0);
+    for _ in 0..ROUNDS {
+        let mut whole = Simulation::new(start.clone(), sim_box).expect("a valid start");
+        let clock = std::time::Instant::now();
+        for _ in 0..events {
+            whole.step().expect("events go on");
+        }
+        let whole_rate = events as f64 / clock.elapsed().as_secs_f64();
+        let divided = Divided::new(start.clone(), sim_box).expect("a valid start");
+        let run = divided.run_unordered(events / 2);
+        let handover = handover_ns();
+        // A disowned particle's events are lost from then on: the rate is too high by at
+        // most about their share (printed), which grows with the run; past a twentieth the
+        // round is no measurement.
+        if run.events != [events / 2; 2] || run.not_numbers != [0; 2] || run.disowned > n / 20 {
+            rounds.push(format!("void ({handover:.0} ns)"));
+            continue;
+        }
+        let ratio = run.rate() / whole_rate;
+        rounds.push(format!("{ratio:.3} ({handover:.0} ns)"));
+        ratios.push(ratio);
+        disowned = disowned.max(run.disowned);
+        late.0 += run.late[0] + run.late[1];
+        late.1 += run.received[0] + run.received[1];
+    }
+    println!(
+        "two threads, round by round: events per second over the whole box's (a cache line from thread to thread after it, one way): {}",
+        rounds.join(", ")
+    );
+    ratios.sort_by(f64::total_cmp);
+    if ratios.is_empty() {
+        println!("divided, two threads: every round void");
+        return;
+    }
+    let median = 0.5 * (ratios[(ratios.len() - 1) / 2] + ratios[ratios.len() / 2]);
+    println!(
+        "divided, two threads, changes applied on arrival (an upper bound): events per second {median:.3} of the whole box's (median of {} rounds, range {:.3}–{:.3}); {:.3} of the changes received arrived in the receiver's past; at most {:.4} of the particles disowned",
+        ratios.len(),
+        ratios[0],
+        ratios[ratios.len() - 1],
+        late.0 as f64 / late.1 as f64,
+        disowned as f64 / n as f64
+    );
+}
+
 fn report(n: usize, events: u64) {
     divided(n, events);
+    two_threads(n, events);
     let (schedules, traffic) = replay(n, events);
     let (range, skin) = range_and_skin();
     println!(

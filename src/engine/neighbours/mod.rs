@@ -378,6 +378,14 @@ impl<const D: usize> Neighbours<D> {
     /// Following, it moves to the next cell (the crossing found again: the same pure function
     /// of the same state).
     pub fn rebuild(&mut self, i: usize, p: &Particle<D>, t: f64) {
+        self.rebuild_among(i, p, t, None);
+    }
+
+    /// [`rebuild`](Self::rebuild), with lists, taking the particles within range of the new
+    /// centre from `given` (what the rebuild of the same particle at the same time found in
+    /// a replica that holds every centre it reads, [`found`](Self::found)) instead of
+    /// scanning for them: the same lists.
+    pub(crate) fn rebuild_among(&mut self, i: usize, p: &Particle<D>, t: f64, given: Option<&[u32]>) {
         if !self.listed {
             let (_, axis, up) =
                 self.cells.next_crossing(&self.cells.coord(i), &p.position, &p.velocity).expect("a crossing");
@@ -402,7 +410,13 @@ impl<const D: usize> Neighbours<D> {
             self.cells.insert(i, &to);
         }
         self.centres[i] = centre;
-        self.scan(i);
+        match given {
+            None => self.scan(i),
+            Some(found) => {
+                self.scratch.clear();
+                self.scratch.extend_from_slice(found);
+            }
+        }
         let found = std::mem::take(&mut self.scratch);
         if old.crowded() {
             // A crowded particle does not know its old neighbours: everyone in the cells
@@ -436,6 +450,12 @@ impl<const D: usize> Neighbours<D> {
         }
         lists::fill(self.rows_mut(i), &found);
         self.scratch = found;
+    }
+
+    /// With lists: the particles within range of the centre of the last
+    /// [`rebuild`](Self::rebuild)'s particle (its list before any cap), until the next.
+    pub(crate) fn found(&self) -> &[u32] {
+        &self.scratch
     }
 
     /// When particle `p` (number `i`) next has to [`rebuild`](Self::rebuild), as an absolute

@@ -18,7 +18,9 @@
 //! After each event the side that resolved it sends a change per particle it changed:
 //! its new state and the partner its prediction skips (the whole box's engine predicts the
 //! lower particle of a pair skipping the higher, the higher skipping none), a neighbourhood
-//! update, or every particle predicted again (an event counter wrapped). The other side
+//! update (with lists, with the members the rebuild found, which the other side takes
+//! instead of scanning again), or every particle predicted again (an event counter
+//! wrapped). The other side
 //! applies all of an event's changes, then predicts those of its own particles among them
 //! with the skips given — at the event's time, as the whole box's engine does. A particle
 //! whose neighbourhood update takes it into the other slab is given away: its slot emptied
@@ -29,6 +31,10 @@
 //! changes before the next item, so every prediction reads the states the whole box's engine
 //! reads: the same events, the same markers, the same counts. Every change is sent, so the
 //! replicas stay equal; what a side needs of the other's is the particles near the border.
+//!
+//! [`Divided::run_unordered`] runs the two sides at once in two threads, each applying the
+//! other's changes when they arrive: not a simulation, but what the division costs and
+//! keeps on two cores with nothing spent on the order of time ([`Unordered`]).
 //!
 //! # Example
 //!
@@ -69,8 +75,10 @@ pub(crate) struct Region<const D: usize> {
     zone: f64,
     /// The changes of the last event, not yet delivered.
     outbox: Vec<Change<D>>,
-    /// Changes told so far.
+    /// Changes told so far (a list's members counted with its `Neighbourhood` change).
     told: u64,
+    /// The members of a list rebuilt on the other side, gathered from its changes.
+    members: Vec<u32>,
 }
 
 /// A slab.
@@ -105,9 +113,18 @@ enum What<const D: usize> {
     /// Particle `k`'s neighbourhood was updated (its list built again around it, or it
     /// moved to the next cell); its state, which the other side may not have.
     Neighbourhood { k: u32, state: Particle<D> },
+    /// With lists, after a `Neighbourhood` change: up to [`CHUNK`] more of the particles
+    /// within range of its particle's new centre (its list as the rebuild found it), which
+    /// the receiver takes instead of scanning its replica, whose centres far from the
+    /// border are out of date.
+    Members { chunk: [u32; CHUNK], len: u8 },
     /// Every particle was predicted again (an event counter wrapped to 0).
     Everyone,
 }
+
+/// How many list members one [`What::Members`] carries: as many as fit in the room a
+/// state takes, so that the change is no larger.
+const CHUNK: usize = 16;
 
 impl<const D: usize> Region<D> {
     fn new(side: Side, sim_box: &SimBox<D>, anchors: Vec<f64>, zone: f64) -> Self {
@@ -122,6 +139,7 @@ impl<const D: usize> Region<D> {
             zone,
             outbox: Vec::new(),
             told: 0,
+            members: Vec::new(),
         }
     }
 
@@ -223,6 +241,7 @@ impl<const D: usize> Simulation<D> {
                 // is told. A list is centred where the particle is: only near ones are.
                 if was_near || near || !self.neighbours.listed() {
                     self.tell(What::Neighbourhood { k: i as u32, state: self.particles[i].clone() });
+                    self.tell_members();
                 }
                 if side == self.region.as_deref().expect("divided").side {
                     self.predict_one(i, guess);
@@ -231,6 +250,18 @@ impl<const D: usize> Simulation<D> {
                 }
             }
             Outcome::Sample | Outcome::GrowthEnd => unreachable!("a divided box neither samples nor grows"),
+        }
+    }
+
+    /// Tells the other side whom the list just rebuilt holds (nothing, following the
+    /// particles).
+    fn tell_members(&mut self) {
+        let region = self.region.as_deref_mut().expect("divided");
+        let time = self.time;
+        for members in self.neighbours.found().chunks(CHUNK) {
+            let mut chunk = [0; CHUNK];
+            chunk[..members.len()].copy_from_slice(members);
+            region.outbox.push(Change { time, what: What::Members { chunk, len: members.len() as u8 } });
         }
     }
 
@@ -254,15 +285,29 @@ impl<const D: usize> Simulation<D> {
     fn receive(&mut self, changes: &[Change<D>]) {
         let Some(first) = changes.first() else { return };
         self.time = first.time;
-        for change in changes {
+        for (at, change) in changes.iter().enumerate() {
             match change.what {
                 What::Course { k, ref state, .. } => self.particles[k as usize] = state.clone(),
                 What::Neighbourhood { k, ref state } => {
                     let k = k as usize;
                     self.particles[k] = state.clone();
-                    sources::neighbourhood::resolve(&mut self.neighbours, k, &self.particles[k], self.time);
+                    if self.neighbours.listed() {
+                        let region = self.region.as_deref_mut().expect("divided");
+                        let mut members = std::mem::take(&mut region.members);
+                        members.clear();
+                        for more in changes[at + 1..].iter().map_while(|c| match c.what {
+                            What::Members { ref chunk, len } => Some(&chunk[..len as usize]),
+                            _ => None,
+                        }) {
+                            members.extend_from_slice(more);
+                        }
+                        self.neighbours.rebuild_among(k, &self.particles[k], self.time, Some(&members));
+                        self.region.as_deref_mut().expect("divided").members = members;
+                    } else {
+                        sources::neighbourhood::resolve(&mut self.neighbours, k, &self.particles[k], self.time);
+                    }
                 }
-                What::Everyone => {}
+                What::Members { .. } | What::Everyone => {}
             }
         }
         for change in changes {
@@ -282,15 +327,89 @@ impl<const D: usize> Simulation<D> {
                         poisoned(&mut self.particles[k]);
                     }
                 }
+                What::Members { .. } => {}
                 What::Everyone => self.predict_everyone(),
             }
         }
+    }
+
+    /// One side of [`Divided::run_unordered`]: resolves `per_side` events of its own (or
+    /// until it has none), sending each event's changes to `out` and applying what `inbox`
+    /// holds after each item. Returns the events, the seconds, the batches received and how
+    /// many of them were late.
+    fn run_side(
+        &mut self,
+        per_side: u64,
+        out: &mailbox::Mailbox<Change<D>>,
+        inbox: &mailbox::Mailbox<Change<D>>,
+    ) -> (u64, f64, u64, u64) {
+        let clock = std::time::Instant::now();
+        let (mut events, mut received, mut late) = (0, 0, 0);
+        let mut batches = mailbox::Batches::default();
+        while events < per_side {
+            match self.take() {
+                Taken::Event(_) => events += 1,
+                Taken::Bookkeeping => {}
+                Taken::End => break,
+            }
+            let region = self.region.as_deref_mut().expect("divided");
+            out.send(&region.outbox);
+            region.outbox.clear();
+            if inbox.take(&mut batches) {
+                for batch in batches.each() {
+                    received += 1;
+                    late += u64::from(batch[0].time < self.time);
+                    self.receive(batch);
+                }
+            }
+        }
+        (events, clock.elapsed().as_secs_f64(), received, late)
+    }
+
+    /// How many of this side's own particles have a position or velocity that is not a
+    /// number.
+    fn not_numbers(&self) -> usize {
+        let finite = |p: &Particle<D>| p.position.iter().chain(p.velocity.iter()).all(|x| x.is_finite());
+        (0..self.particles.len()).filter(|&k| self.owns(k) && !finite(&self.particles[k])).count()
     }
 
     /// The earliest item of this side's queue: its owner and the event.
     fn earliest(&mut self) -> (u32, Event) {
         let (owner, event) = self.queue.first();
         (owner as u32, event)
+    }
+}
+
+/// What [`Divided::run_unordered`] measured: each side's events and thread time, and how
+/// the changes it received arrived.
+#[derive(Clone, Copy, Debug, PartialEq)]
+#[non_exhaustive]
+pub struct Unordered {
+    /// Events each side resolved (re-prediction markers not counted), the lower side's first.
+    pub events: [u64; 2],
+    /// Each side's thread's time from the start to its last event, in seconds.
+    pub seconds: [f64; 2],
+    /// Batches of changes (one per event of the other side that changed anything it holds)
+    /// each side received.
+    pub received: [u64; 2],
+    /// How many of those arrived in the receiver's past: the event that sent them was
+    /// earlier than the receiver's clock. An engine that keeps the order of time has to
+    /// undo (or to have waited for) what it did since, when it read what they change.
+    pub late: [u64; 2],
+    /// How many of its own particles each side holds with a position or velocity that is
+    /// not a number at the end: what reading in the wrong order can do to the replicas (a
+    /// measurement with any is void). Ran out of events: `events` says so.
+    pub not_numbers: [usize; 2],
+    /// Particles that neither side holds for its own at the end (each side's view): their
+    /// events are lost, so a measurement with any is void too.
+    pub disowned: usize,
+}
+
+impl Unordered {
+    /// Events per second of both sides together: all their events over the slower side's
+    /// time.
+    pub fn rate(&self) -> f64 {
+        (self.events[0] + self.events[1]) as f64 / self.seconds[0].max(self.seconds[1])
     }
 }
 
@@ -417,7 +536,33 @@ impl<const D: usize> Divided<D> {
             (0..s.particles.len()).filter(|&k| region.owner[k] != region.side && region.near(k)).count()
         })
     }
+
+    /// Runs both sides at once, each in its own thread until it has resolved `per_side`
+    /// events, each applying the other's changes when they arrive instead of in the order of
+    /// time: a measurement of what the division costs and keeps on two cores with nothing
+    /// spent on keeping the order — an upper bound on an engine that keeps it. Not a
+    /// simulation: the sides' replicas no longer agree, and the events are not the whole
+    /// box's, so the divided box is consumed.
+    pub fn run_unordered(self, per_side: u64) -> Unordered {
+        let [mut lower, mut upper] = self.sides;
+        let mailboxes = [mailbox::Mailbox::default(), mailbox::Mailbox::default()];
+        let [to_lower, to_upper] = &mailboxes;
+        let [a, b] = std::thread::scope(|scope| {
+            let thread = scope.spawn(|| lower.run_side(per_side, to_upper, to_lower));
+            let here = upper.run_side(per_side, to_lower, to_upper);
+            [thread.join().expect("the lower side's thread"), here]
+        });
+        Unordered {
+            events: [a.0, b.0],
+            seconds: [a.1, b.1],
+            received: [a.2, b.2],
+            late: [a.3, b.3],
+            not_numbers: [lower.not_numbers(), upper.not_numbers()],
+            disowned: (0..lower.particles.len()).filter(|&k| !lower.owns(k) && !upper.owns(k)).count(),
+        }
+    }
 }
 
+mod mailbox;
 #[cfg(test)]
 mod tests;
