@@ -378,14 +378,20 @@ impl<const D: usize> Neighbours<D> {
     /// Following, it moves to the next cell (the crossing found again: the same pure function
     /// of the same state).
     pub fn rebuild(&mut self, i: usize, p: &Particle<D>, t: f64) {
-        self.rebuild_among(i, p, t, None);
+        self.rebuild_among(i, p, t, None::<std::iter::Empty<u32>>);
     }
 
-    /// [`rebuild`](Self::rebuild), with lists, taking the particles within range of the new
+    /// [`rebuild`](Self::rebuild), with lists taking the particles within range of the new
     /// centre from `given` (what the rebuild of the same particle at the same time found in
     /// a replica that holds every centre it reads, [`found`](Self::found)) instead of
-    /// scanning for them: the same lists.
-    pub(crate) fn rebuild_among(&mut self, i: usize, p: &Particle<D>, t: f64, given: Option<&[u32]>) {
+    /// scanning for them: the same lists. Following the particles, `given` is not read.
+    pub(crate) fn rebuild_among(
+        &mut self,
+        i: usize,
+        p: &Particle<D>,
+        t: f64,
+        given: Option<impl IntoIterator<Item = u32>>,
+    ) {
         if !self.listed {
             let (_, axis, up) =
                 self.cells.next_crossing(&self.cells.coord(i), &p.position, &p.velocity).expect("a crossing");
@@ -414,7 +420,7 @@ impl<const D: usize> Neighbours<D> {
             None => self.scan(i),
             Some(found) => {
                 self.scratch.clear();
-                self.scratch.extend_from_slice(found);
+                self.scratch.extend(found);
             }
         }
         let found = std::mem::take(&mut self.scratch);

@@ -55,7 +55,7 @@ use super::{Simulation, Taken};
 use crate::engine::geometry::{Boundary, Particle, SimBox};
 use crate::engine::params::EngineParams;
 use crate::engine::setup::SetupError;
-use crate::engine::sources::{self, Event, EventCounts, Outcome};
+use crate::engine::sources::{Event, EventCounts, Outcome};
 
 /// One side's view of the division: its slab, every particle's side and what it has still
 /// to tell the other side.
@@ -77,8 +77,6 @@ pub(crate) struct Region<const D: usize> {
     outbox: Vec<Change<D>>,
     /// Changes told so far (a list's members counted with its `Neighbourhood` change).
     told: u64,
-    /// The members of a list rebuilt on the other side, gathered from its changes.
-    members: Vec<u32>,
 }
 
 /// A slab.
@@ -139,7 +137,6 @@ impl<const D: usize> Region<D> {
             zone,
             outbox: Vec::new(),
             told: 0,
-            members: Vec::new(),
         }
     }
 
@@ -291,21 +288,13 @@ impl<const D: usize> Simulation<D> {
                 What::Neighbourhood { k, ref state } => {
                     let k = k as usize;
                     self.particles[k] = state.clone();
-                    if self.neighbours.listed() {
-                        let region = self.region.as_deref_mut().expect("divided");
-                        let mut members = std::mem::take(&mut region.members);
-                        members.clear();
-                        for more in changes[at + 1..].iter().map_while(|c| match c.what {
-                            What::Members { ref chunk, len } => Some(&chunk[..len as usize]),
-                            _ => None,
-                        }) {
-                            members.extend_from_slice(more);
-                        }
-                        self.neighbours.rebuild_among(k, &self.particles[k], self.time, Some(&members));
-                        self.region.as_deref_mut().expect("divided").members = members;
-                    } else {
-                        sources::neighbourhood::resolve(&mut self.neighbours, k, &self.particles[k], self.time);
-                    }
+                    // With lists, the members the rebuild found follow the update.
+                    let members = changes[at + 1..].iter().map_while(|c| match c.what {
+                        What::Members { ref chunk, len } => Some(&chunk[..len as usize]),
+                        _ => None,
+                    });
+                    let members = members.flatten().copied();
+                    self.neighbours.rebuild_among(k, &self.particles[k], self.time, Some(members));
                 }
                 What::Members { .. } | What::Everyone => {}
             }
@@ -355,15 +344,28 @@ impl<const D: usize> Simulation<D> {
             let region = self.region.as_deref_mut().expect("divided");
             out.send(&region.outbox);
             region.outbox.clear();
-            if inbox.take(&mut batches) {
-                for batch in batches.each() {
-                    received += 1;
-                    late += u64::from(batch[0].time < self.time);
-                    self.receive(batch);
-                }
-            }
+            let (r, l) = self.deliver(inbox, &mut batches);
+            (received, late) = (received + r, late + l);
         }
         (events, clock.elapsed().as_secs_f64(), received, late)
+    }
+
+    /// Applies every batch of changes waiting in `inbox` (taken into `batches`): how many,
+    /// and how many arrived in this side's past.
+    fn deliver(
+        &mut self,
+        inbox: &mailbox::Mailbox<Change<D>>,
+        batches: &mut mailbox::Batches<Change<D>>,
+    ) -> (u64, u64) {
+        let (mut received, mut late) = (0, 0);
+        if inbox.take(batches) {
+            for batch in batches.each() {
+                received += 1;
+                late += u64::from(batch[0].time < self.time);
+                self.receive(batch);
+            }
+        }
+        (received, late)
     }
 
     /// How many of this side's own particles have a position or velocity that is not a
@@ -390,7 +392,7 @@ pub struct Unordered {
     /// Each side's thread's time from the start to its last event, in seconds.
     pub seconds: [f64; 2],
     /// Batches of changes (one per event of the other side that changed anything it holds)
-    /// each side received.
+    /// each side received while it ran.
     pub received: [u64; 2],
     /// How many of those arrived in the receiver's past: the event that sent them was
     /// earlier than the receiver's clock. An engine that keeps the order of time has to
@@ -400,8 +402,9 @@ pub struct Unordered {
     /// not a number at the end: what reading in the wrong order can do to the replicas (a
     /// measurement with any is void). Ran out of events: `events` says so.
     pub not_numbers: [usize; 2],
-    /// Particles that neither side holds for its own at the end (each side's view): their
-    /// events are lost, so a measurement with any is void too.
+    /// Particles that neither side holds for its own at the end (each side's view, after
+    /// each has applied what the other sent once it had stopped): their events were lost
+    /// during the run.
     pub disowned: usize,
 }
 
@@ -552,6 +555,11 @@ impl<const D: usize> Divided<D> {
             let here = upper.run_side(per_side, to_lower, to_upper);
             [thread.join().expect("the lower side's thread"), here]
         });
+        // What a side sent after the other had stopped (a particle given away, say) is
+        // applied now, so that the end state counts only what the disorder did.
+        let mut batches = mailbox::Batches::default();
+        lower.deliver(to_lower, &mut batches);
+        upper.deliver(to_upper, &mut batches);
         Unordered {
             events: [a.0, b.0],
             seconds: [a.1, b.1],
