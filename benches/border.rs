@@ -449,8 +449,17 @@ fn two_threads(sim: &Simulation<3>, events: u64) {
         let handover = handover_ns();
         // A side that ran out of events, a state gone NaN or a particle neither side holds
         // (its events lost) makes the round no measurement.
-        if run.events != [events / 2; 2] || run.not_numbers != [0; 2] || run.disowned > 0 {
-            rounds.push(format!("void ({handover:.0} ns)"));
+        let why = if run.events != [events / 2; 2] {
+            Some(format!("a side ran out of events ({:?} of {}, holding {:?})", run.events, events / 2, run.held))
+        } else if run.not_numbers != [0; 2] {
+            Some(format!("{} states not numbers", run.not_numbers[0] + run.not_numbers[1]))
+        } else if run.disowned > 0 {
+            Some(format!("{} disowned", run.disowned))
+        } else {
+            None
+        };
+        if let Some(why) = why {
+            rounds.push(format!("void: {why} ({handover:.0} ns)"));
             continue;
         }
         let ratio = run.rate() / whole_rate;

@@ -166,7 +166,7 @@ impl<const D: usize> Neighbours<D> {
 
     /// Whether particle `i` (with lists) is crowded.
     #[inline]
-    fn is_crowded(&self, i: usize) -> bool {
+    pub(crate) fn is_crowded(&self, i: usize) -> bool {
         lists::crowded(self.rows(i))
     }
 
@@ -378,51 +378,9 @@ impl<const D: usize> Neighbours<D> {
     /// Following, it moves to the next cell (the crossing found again: the same pure function
     /// of the same state).
     pub fn rebuild(&mut self, i: usize, p: &Particle<D>, t: f64) {
-        self.rebuild_among(i, p, t, None::<std::iter::Empty<u32>>);
-    }
-
-    /// [`rebuild`](Self::rebuild), with lists taking the particles within range of the new
-    /// centre from `given` (what the rebuild of the same particle at the same time found in
-    /// a replica that holds every centre it reads, [`found`](Self::found)) instead of
-    /// scanning for them: the same lists. Following the particles, `given` is not read.
-    pub(crate) fn rebuild_among(
-        &mut self,
-        i: usize,
-        p: &Particle<D>,
-        t: f64,
-        given: Option<impl IntoIterator<Item = u32>>,
-    ) {
-        if !self.listed {
-            let (_, axis, up) =
-                self.cells.next_crossing(&self.cells.coord(i), &p.position, &p.velocity).expect("a crossing");
-            self.cells.shift(i, axis, up);
-            return;
-        }
-        // The new neighbours first, then leave the lists of the old neighbours no longer in
-        // range and join those of the new ones not in range before (neither changes what the
-        // scan reads): the scan's walk of the cells gives the old neighbours' rows, asked for
-        // before the event (`Timing::leaving`), time to arrive. A particle leaves its skin
-        // having moved half a skin, and most of its neighbours stay: their rows are left
-        // alone (leaving and joining again would only move `i` to the row's end, and which
-        // entry of a row holds whom changes no search).
-        let mut old = [List::EMPTY; lists::MAX_ROWS];
-        old[..Self::ROWS].copy_from_slice(self.rows(i));
+        let Some((old, from)) = self.recentre(i, p, t) else { return };
         let old = Rows(&old[..Self::ROWS]);
-        let from = self.cell(i);
-        let centre = p.position_at(t);
-        let to = self.cells.locate(&centre);
-        if from != to {
-            self.cells.remove(i, &from);
-            self.cells.insert(i, &to);
-        }
-        self.centres[i] = centre;
-        match given {
-            None => self.scan(i),
-            Some(found) => {
-                self.scratch.clear();
-                self.scratch.extend(found);
-            }
-        }
+        self.scan(i);
         let found = std::mem::take(&mut self.scratch);
         if old.crowded() {
             // A crowded particle does not know its old neighbours: everyone in the cells
@@ -456,6 +414,91 @@ impl<const D: usize> Neighbours<D> {
         }
         lists::fill(self.rows_mut(i), &found);
         self.scratch = found;
+    }
+
+    /// [`rebuild`](Self::rebuild) in a replica that holds only some of the particles
+    /// exactly, the `mine` ones' rows and every centre within reach of them: with lists, the
+    /// particles within range of the new centre are `given` (what the rebuild of the same
+    /// particle at the same time found in a replica that holds every centre it reads,
+    /// [`found`](Self::found)) instead of scanned for, and only the `mine` rows take the
+    /// change — every other row of this replica is left as it was, out of date. So whether
+    /// `i` joins a row of `mine` is asked of that row, not of `i`'s old list, whose other
+    /// entries may be out of date; which rows of `mine` it leaves is asked of the old list,
+    /// which lists at least every particle of `mine` whose row holds `i`: each row of `mine`
+    /// gains a particle at its own rebuild (which puts it into that particle's list too), at
+    /// the other's (here, the list filled with it), or when it becomes one of `mine` — `i`
+    /// does when it `joins` (its rebuild takes it into this replica's slab), and then every
+    /// member's row takes it. An entry of `mine` out of date in another's list only makes
+    /// `i` leave a row that does not hold it, which changes nothing. Following the
+    /// particles, `given` is not read.
+    pub(crate) fn rebuild_told(
+        &mut self,
+        i: usize,
+        p: &Particle<D>,
+        t: f64,
+        given: impl IntoIterator<Item = u32>,
+        mine: impl Fn(usize) -> bool,
+        joins: bool,
+    ) {
+        let Some((old, from)) = self.recentre(i, p, t) else { return };
+        let old = Rows(&old[..Self::ROWS]);
+        let mut found = std::mem::take(&mut self.scratch);
+        found.clear();
+        found.extend(given);
+        if old.crowded() {
+            let rows = Self::ROWS;
+            for j in self.cells.neighbours(from) {
+                if j != i && mine(j) {
+                    lists::drop(&mut self.lists[j * rows..(j + 1) * rows], i as u32);
+                }
+            }
+        } else {
+            for j in old.members() {
+                if mine(j) && !found.contains(&(j as u32)) {
+                    lists::drop(self.rows_mut(j), i as u32);
+                }
+            }
+        }
+        for &j in &found {
+            let j = j as usize;
+            if (joins || mine(j)) && !Rows(self.rows(j)).entries().any(|k| k == i as u32) {
+                lists::add(self.rows_mut(j), i as u32);
+            }
+        }
+        lists::fill(self.rows_mut(i), &found);
+        self.scratch = found;
+    }
+
+    /// The first half of a rebuild: following the particles, the move to the next cell
+    /// (then `None`, nothing more to do); with lists, the centre moved to where the particle
+    /// is at `t` (and its cell with it), returning its rows and cell before.
+    #[inline(always)]
+    fn recentre(&mut self, i: usize, p: &Particle<D>, t: f64) -> Option<([List; lists::MAX_ROWS], Coord<D>)> {
+        if !self.listed {
+            let (_, axis, up) =
+                self.cells.next_crossing(&self.cells.coord(i), &p.position, &p.velocity).expect("a crossing");
+            self.cells.shift(i, axis, up);
+            return None;
+        }
+        // The new neighbours are found first (by the caller), then `i` leaves the lists of
+        // the old neighbours no longer in range and joins those of the new ones not in
+        // range before (neither changes what the scan reads): the scan's walk of the cells
+        // gives the old neighbours' rows, asked for before the event (`Timing::leaving`),
+        // time to arrive. A particle leaves its skin having moved half a skin, and most of
+        // its neighbours stay: their rows are left alone (leaving and joining again would
+        // only move `i` to the row's end, and which entry of a row holds whom changes no
+        // search).
+        let mut old = [List::EMPTY; lists::MAX_ROWS];
+        old[..Self::ROWS].copy_from_slice(self.rows(i));
+        let from = self.cell(i);
+        let centre = p.position_at(t);
+        let to = self.cells.locate(&centre);
+        if from != to {
+            self.cells.remove(i, &from);
+            self.cells.insert(i, &to);
+        }
+        self.centres[i] = centre;
+        Some((old, from))
     }
 
     /// With lists: the particles within range of the centre of the last
@@ -564,12 +607,31 @@ impl<const D: usize> Neighbours<D> {
     /// copy stays a few instructions where it is inlined.
     #[inline(never)]
     fn gather_cells(&self, i: usize, skip: usize, out: &mut [u32]) -> Option<usize> {
-        self.cells.gather(&self.cell(i), i, skip, out)
+        if self.listed { self.gather_crowded(i, skip, out) } else { self.cells.gather(&self.cell(i), i, skip, out) }
     }
 
-    /// The particles that can touch `i` before it next rebuilds — its list, or (crowded, or
-    /// without lists) everyone in the cells around it, `i` included — the same set the
-    /// batch search sees through [`gather`](Self::gather).
+    /// [`gather`](Self::gather) for a crowded particle: the members of the cells around its
+    /// centre whose centres are within range — its list, had the rows room for it. Only
+    /// they can touch it before either rebuilds; the others' predictions would be overtaken
+    /// by a rebuild, and reading them would make a crowded particle's reads reach two cell
+    /// widths where a list's reach one range (the divided box's zone is the lists' reach).
+    #[inline]
+    fn gather_crowded(&self, i: usize, skip: usize, out: &mut [u32]) -> Option<usize> {
+        let len = self.cells.gather(&self.cell(i), i, skip, out)?;
+        let c = self.centres[i];
+        let mut kept = 0;
+        for k in 0..len {
+            let j = out[k];
+            out[kept] = j;
+            kept += (self.apart2(&c, &self.centres[j as usize]) < self.range2) as usize;
+        }
+        Some(kept)
+    }
+
+    /// The particles in the cells around `i` (with lists, `i`'s list instead unless it is
+    /// crowded), `i` included: every particle that can touch `i` before it next rebuilds,
+    /// and, crowded or following, some that cannot. For checks and audits, which read
+    /// everyone there.
     pub fn candidates(&self, i: usize) -> impl Iterator<Item = usize> + '_ {
         let list = self.row(i).filter(|list| !list.crowded());
         let listed = list.into_iter().flat_map(|list| list.members());
@@ -577,13 +639,30 @@ impl<const D: usize> Neighbours<D> {
         listed.chain(grid)
     }
 
+    /// Whether the searches read candidate `j` of `i` ([`candidates`](Self::candidates)):
+    /// all of them, but a crowded particle's only those whose centres are within range —
+    /// the same set the batch search sees through [`gather`](Self::gather).
+    #[inline(never)]
+    pub(crate) fn searches(&self, i: usize, j: usize) -> bool {
+        !self.listed || self.apart2(&self.centres[i], &self.centres[j]) < self.range2
+    }
+
     /// How far along `axis` from where a particle last updated its neighbourhood (its list's
-    /// centre, or where it entered its cell) the particles its predictions read last updated
-    /// theirs, at most: they are members of its list (centres within the range, no wider
-    /// than a cell) or of the cells around its own, two cell widths; a quarter of a width
-    /// more against rounding at the cells' edges.
+    /// centre, or where it entered its cell) the particles its predictions and rebuilds read
+    /// last updated theirs, at most. With lists, `R + s/2`: a prediction reads the members
+    /// (centres within the range `R`, a crowded particle's too), and a rebuild those within
+    /// `R` of its new centre, at most half a skin `s` from the old; a rebuild's walk of the
+    /// cells reads centres further out, but only to find them out of range, which a far
+    /// centre out of date still is. Following the particles, everyone in the cells around
+    /// its own: two cell widths. A hundredth of a skin (a quarter of a width) more against
+    /// rounding.
     pub(crate) fn read_reach(&self, axis: usize) -> f64 {
-        2.25 * self.cells.width(axis)
+        if self.listed {
+            let half_skin = self.bound2.sqrt();
+            self.range2.sqrt() + 1.02 * half_skin
+        } else {
+            2.25 * self.cells.width(axis)
+        }
     }
 
     /// The cell grid (of centres with lists; following the particles without).
@@ -608,8 +687,15 @@ impl<const D: usize> Neighbours<D> {
     /// centres are within range (for the particles that are not crowded); for tests.
     #[cfg(test)]
     pub fn check(&self) {
+        self.check_among(|_| true);
+    }
+
+    /// [`check`](Self::check) for the rows of the `mine` particles only (the rows a
+    /// replica of the divided box keeps exact); for tests.
+    #[cfg(test)]
+    pub(crate) fn check_among(&self, mine: impl Fn(usize) -> bool) {
         for i in 0..self.centres.len() {
-            if self.is_crowded(i) {
+            if self.is_crowded(i) || !mine(i) {
                 continue;
             }
             let mut listed: Vec<u32> = Rows(self.rows(i)).members().map(|j| j as u32).collect();

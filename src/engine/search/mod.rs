@@ -312,7 +312,7 @@ fn scalar<const D: usize>(
     let mut hits = [(0u32, 0.0f64); HITS];
     let mut n_hits = 0;
     for j in neighbours.candidates(i) {
-        if j == i || j == skip {
+        if j == i || j == skip || !neighbours.searches(i, j) {
             continue;
         }
         let q = &particles[j];

@@ -294,7 +294,13 @@ impl<const D: usize> Simulation<D> {
                         _ => None,
                     });
                     let members = members.flatten().copied();
-                    self.neighbours.rebuild_among(k, &self.particles[k], self.time, Some(members));
+                    // Only this side's rows take the change (it never reads the others'),
+                    // and, when the particle comes into this slab, its new neighbours'.
+                    let region = self.region.as_deref().expect("divided");
+                    let x = self.particles[k].position_at(self.time)[0].rem_euclid(2.0 * region.half);
+                    let joins = Side::of(x, region.half) == region.side;
+                    let mine = |j: usize| region.owner[j] == region.side;
+                    self.neighbours.rebuild_told(k, &self.particles[k], self.time, members, mine, joins);
                 }
                 What::Members { .. } | What::Everyone => {}
             }
@@ -375,6 +381,11 @@ impl<const D: usize> Simulation<D> {
         (0..self.particles.len()).filter(|&k| self.owns(k) && !finite(&self.particles[k])).count()
     }
 
+    /// How many particles this side holds for its own.
+    fn held(&self) -> usize {
+        (0..self.particles.len()).filter(|&k| self.owns(k)).count()
+    }
+
     /// The earliest item of this side's queue: its owner and the event.
     fn earliest(&mut self) -> (u32, Event) {
         let (owner, event) = self.queue.first();
@@ -406,6 +417,8 @@ pub struct Unordered {
     /// each has applied what the other sent once it had stopped): their events were lost
     /// during the run.
     pub disowned: usize,
+    /// How many particles each side holds for its own at the end.
+    pub held: [usize; 2],
 }
 
 impl Unordered {
@@ -567,6 +580,7 @@ impl<const D: usize> Divided<D> {
             late: [a.3, b.3],
             not_numbers: [lower.not_numbers(), upper.not_numbers()],
             disowned: (0..lower.particles.len()).filter(|&k| !lower.owns(k) && !upper.owns(k)).count(),
+            held: [lower.held(), upper.held()],
         }
     }
 }

@@ -30,6 +30,10 @@ fn same_events<const D: usize>(
     assert_eq!(whole.particles(), &divided.particles()[..]);
     assert_eq!(whole.time(), divided.time());
     assert!(divided.replicas_agree());
+    // Each side's own rows are exact (the rows of the other's it leaves out of date).
+    for side in &divided.sides {
+        side.neighbours.check_among(|k| side.owns(k));
+    }
     // Each side holds the states of some of the other's particles, not all.
     let (known, sides) = (divided.known(), divided.sides());
     assert!(known[0] > 0 && known[0] < sides[1] && known[1] > 0 && known[1] < sides[0], "{known:?} of {sides:?}");
