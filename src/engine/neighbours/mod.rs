@@ -166,7 +166,7 @@ impl<const D: usize> Neighbours<D> {
 
     /// Whether particle `i` (with lists) is crowded.
     #[inline]
-    pub(crate) fn is_crowded(&self, i: usize) -> bool {
+    fn is_crowded(&self, i: usize) -> bool {
         lists::crowded(self.rows(i))
     }
 
@@ -323,7 +323,7 @@ impl<const D: usize> Neighbours<D> {
 
     /// Whether the centres of `i` and `j` are within range (minimum image): the lists'
     /// definition, checked by [`check`](Self::check).
-    #[cfg(test)]
+    #[inline]
     fn within(&self, i: usize, j: usize) -> bool {
         self.apart2(&self.centres[i], &self.centres[j]) < self.range2
     }
@@ -618,12 +618,11 @@ impl<const D: usize> Neighbours<D> {
     #[inline]
     fn gather_crowded(&self, i: usize, skip: usize, out: &mut [u32]) -> Option<usize> {
         let len = self.cells.gather(&self.cell(i), i, skip, out)?;
-        let c = self.centres[i];
         let mut kept = 0;
         for k in 0..len {
             let j = out[k];
             out[kept] = j;
-            kept += (self.apart2(&c, &self.centres[j as usize]) < self.range2) as usize;
+            kept += self.within(i, j as usize) as usize;
         }
         Some(kept)
     }
@@ -644,7 +643,7 @@ impl<const D: usize> Neighbours<D> {
     /// the same set the batch search sees through [`gather`](Self::gather).
     #[inline(never)]
     pub(crate) fn searches(&self, i: usize, j: usize) -> bool {
-        !self.listed || self.apart2(&self.centres[i], &self.centres[j]) < self.range2
+        !self.listed || self.within(i, j)
     }
 
     /// How far along `axis` from where a particle last updated its neighbourhood (its list's

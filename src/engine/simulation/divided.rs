@@ -155,6 +155,11 @@ impl<const D: usize> Region<D> {
         self.owner[k] = Side::of(self.anchor[k], self.half);
         self.owner[k]
     }
+
+    /// The side an anchor at first coordinate `x` would take (as [`anchor_at`](Self::anchor_at)).
+    fn side_at(&self, x: f64) -> Side {
+        Side::of(x.rem_euclid(2.0 * self.half), self.half)
+    }
 }
 
 /// What a side holds of a particle of the other side that is not near: nothing it may read.
@@ -297,8 +302,7 @@ impl<const D: usize> Simulation<D> {
                     // Only this side's rows take the change (it never reads the others'),
                     // and, when the particle comes into this slab, its new neighbours'.
                     let region = self.region.as_deref().expect("divided");
-                    let x = self.particles[k].position_at(self.time)[0].rem_euclid(2.0 * region.half);
-                    let joins = Side::of(x, region.half) == region.side;
+                    let joins = region.side_at(self.particles[k].position_at(self.time)[0]) == region.side;
                     let mine = |j: usize| region.owner[j] == region.side;
                     self.neighbours.rebuild_told(k, &self.particles[k], self.time, members, mine, joins);
                 }
