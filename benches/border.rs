@@ -41,7 +41,13 @@
 //! same division in two threads that apply each other's changes on arrival
 //! ([`Divided::run_unordered`], an upper bound on a two-thread engine that keeps the order
 //! of time), against the whole box in five alternated rounds, each followed by the time a
-//! cache line takes from one thread to the other, on which it depends.
+//! cache line takes from one thread to the other, on which it depends: free, and with
+//! each side held within 16 and 64 of the whole box's mean times between events of the
+//! other (as an engine that undoes what it did too early would hold them, so that its
+//! undo records stay few). For each, how many of the changes that arrived late met a
+//! particle the receiver had read since (its events' particles and their neighbours) —
+//! those an engine that keeps the order has to undo its events for — and how many events
+//! of its own lay between.
 //!
 //! ```text
 //! cargo bench --bench border                          # N = 10 976 and 97 556, 10⁶ events each
@@ -51,7 +57,7 @@
 //! With `--test` (as `cargo bench -- --test` runs every bench) it checks the schedule on
 //! cases with known answers and replays a small system.
 
-use collide::engine::{Divided, Outcome, RANGE_HOLDS_3D, SimBox, Simulation};
+use collide::engine::{Divided, End, Lead, Outcome, RANGE_HOLDS_3D, SimBox, Simulation};
 use nalgebra::Vector3;
 
 /// Packing fraction of the replayed fluid.
@@ -428,15 +434,33 @@ fn handover_ns() -> f64 {
     clock.elapsed().as_secs_f64() / PASSES as f64 * 1e9
 }
 
+/// How far ahead of the other a side of the two-thread runs may go: as far as it goes, or
+/// this many of the whole box's mean times between events (`None`: free).
+const LEADS: [Option<f64>; 3] = [None, Some(16.0), Some(64.0)];
+
 /// The engine's own division in two threads, each side applying the other's changes as
-/// they arrive ([`Divided::run_unordered`]): its events per second against the whole box's
-/// from the same warmed-up start, in `ROUNDS` rounds alternated in this process (median
-/// ratio and range), and the share of the changes received that arrived in the receiver's
-/// past.
+/// they arrive ([`Divided::run_unordered`]), free or held within a lead of the other
+/// ([`LEADS`]): its events per second against the whole box's from the same warmed-up
+/// start, in `ROUNDS` rounds alternated in this process (median ratio and range), the share
+/// of the changes received that arrived in the receiver's past, and what an engine that
+/// keeps the order would undo: the late changes that meet a particle read since, and the
+/// events since them.
 fn two_threads(sim: &Simulation<3>, events: u64) {
     const ROUNDS: usize = 5;
     let (start, sim_box) = (sim.particles().to_vec(), *sim.sim_box());
-    let (mut ratios, mut rounds, mut late) = (Vec::new(), Vec::new(), (0, 0));
+    // The whole box's mean time between events over the warm-up.
+    let interval = sim.time() / sim.counts().total() as f64;
+    #[derive(Default)]
+    struct Tally {
+        ratios: Vec<f64>,
+        rounds: Vec<String>,
+        received: u64,
+        late: u64,
+        conflicts: u64,
+        undone: u64,
+        events: u64,
+    }
+    let mut tallies: Vec<Tally> = LEADS.iter().map(|_| Tally::default()).collect();
     for _ in 0..ROUNDS {
         let mut whole = Simulation::new(start.clone(), sim_box).expect("a valid start");
         let clock = std::time::Instant::now();
@@ -444,47 +468,66 @@ fn two_threads(sim: &Simulation<3>, events: u64) {
             whole.step().expect("events go on");
         }
         let whole_rate = events as f64 / clock.elapsed().as_secs_f64();
-        let divided = Divided::new(start.clone(), sim_box).expect("a valid start");
-        let run = divided.run_unordered(events / 2);
-        let handover = handover_ns();
-        // A side that ran out of events, a state gone NaN or a particle neither side holds
-        // (its events lost) makes the round no measurement.
-        let why = if run.events != [events / 2; 2] {
-            Some(format!("a side ran out of events ({:?} of {}, holding {:?})", run.events, events / 2, run.held))
-        } else if run.not_numbers != [0; 2] {
-            Some(format!("{} states not numbers", run.not_numbers[0] + run.not_numbers[1]))
-        } else if run.disowned > 0 {
-            Some(format!("{} disowned", run.disowned))
-        } else {
-            None
-        };
-        if let Some(why) = why {
-            rounds.push(format!("void: {why} ({handover:.0} ns)"));
+        for (lead, tally) in LEADS.iter().zip(&mut tallies) {
+            let lead = lead.map_or(Lead::Free, |w| Lead::Within(w * interval));
+            let divided = Divided::new(start.clone(), sim_box).expect("a valid start");
+            let run = divided.run_unordered(events / 2, lead);
+            let handover = handover_ns();
+            // A side that ran out of events, a state gone NaN, a particle neither side holds
+            // (its events lost) or a chain of collisions that stops the clock (particles
+            // overlapping) makes the round no measurement.
+            let stall = run.stall[0].max(run.stall[1]);
+            let why = if run.end.contains(&End::RanOut) {
+                Some(format!("a side ran out of events ({:?}, holding {:?})", run.events, run.held))
+            } else if run.not_numbers != [0; 2] {
+                Some(format!("{} states not numbers", run.not_numbers[0] + run.not_numbers[1]))
+            } else if run.disowned > 0 {
+                Some(format!("{} disowned", run.disowned))
+            } else if stall > 100 {
+                Some(format!("{stall} events at one time"))
+            } else {
+                None
+            };
+            if let Some(why) = why {
+                tally.rounds.push(format!("void: {why} ({handover:.0} ns)"));
+                continue;
+            }
+            let ratio = run.rate() / whole_rate;
+            tally.rounds.push(format!("{ratio:.3} ({handover:.0} ns)"));
+            tally.ratios.push(ratio);
+            tally.late += run.late[0] + run.late[1];
+            tally.received += run.received[0] + run.received[1];
+            tally.conflicts += run.conflicts[0] + run.conflicts[1];
+            tally.undone += run.undone[0] + run.undone[1];
+            tally.events += run.events[0] + run.events[1];
+        }
+    }
+    println!(
+        "divided, two threads, changes applied on arrival (upper bounds): events per second over the whole box's, round by round (a cache line from thread to thread after it, one way)"
+    );
+    println!(
+        "| lead | median (range) | rounds | late changes | late changes meeting a read, per event | events since them, per event |"
+    );
+    for (lead, tally) in LEADS.iter().zip(&mut tallies) {
+        let lead = lead.map_or("free".to_string(), |w| format!("{w} intervals"));
+        let Tally { ratios, rounds, .. } = tally;
+        ratios.sort_by(f64::total_cmp);
+        if ratios.is_empty() {
+            println!("| {lead} | every round void | {} | | | |", rounds.join(", "));
             continue;
         }
-        let ratio = run.rate() / whole_rate;
-        rounds.push(format!("{ratio:.3} ({handover:.0} ns)"));
-        ratios.push(ratio);
-        late.0 += run.late[0] + run.late[1];
-        late.1 += run.received[0] + run.received[1];
+        let median = 0.5 * (ratios[(ratios.len() - 1) / 2] + ratios[ratios.len() / 2]);
+        let per_event = |x: u64| x as f64 / tally.events as f64;
+        println!(
+            "| {lead} | {median:.3} ({:.3}–{:.3}) | {} | {:.3} | {:.5} | {:.4} |",
+            ratios[0],
+            ratios[ratios.len() - 1],
+            rounds.join(", "),
+            tally.late as f64 / tally.received as f64,
+            per_event(tally.conflicts),
+            per_event(tally.undone)
+        );
     }
-    println!(
-        "two threads, round by round: events per second over the whole box's (a cache line from thread to thread after it, one way): {}",
-        rounds.join(", ")
-    );
-    ratios.sort_by(f64::total_cmp);
-    if ratios.is_empty() {
-        println!("divided, two threads: every round void");
-        return;
-    }
-    let median = 0.5 * (ratios[(ratios.len() - 1) / 2] + ratios[ratios.len() / 2]);
-    println!(
-        "divided, two threads, changes applied on arrival (an upper bound): events per second {median:.3} of the whole box's (median of {} rounds, range {:.3}–{:.3}); {:.3} of the changes received arrived in the receiver's past",
-        ratios.len(),
-        ratios[0],
-        ratios[ratios.len() - 1],
-        late.0 as f64 / late.1 as f64
-    );
 }
 
 fn report(n: usize, events: u64) {

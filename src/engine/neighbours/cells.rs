@@ -286,7 +286,7 @@ impl<const D: usize> Cells<D> {
     }
 
     /// The flat index of cell `m`.
-    fn flat(&self, m: &Coord<D>) -> usize {
+    pub(crate) fn flat(&self, m: &Coord<D>) -> usize {
         (0..D).map(|a| m[a] as usize * self.strides[a]).sum()
     }
 

@@ -646,6 +646,22 @@ impl<const D: usize> Neighbours<D> {
         !self.listed || self.within(i, j)
     }
 
+    /// The flat index of particle `i`'s cell (its centre's, with lists).
+    pub(crate) fn cell_index(&self, i: usize) -> usize {
+        self.cells.flat(&self.cell(i))
+    }
+
+    /// The flat indices of the cells around `i`'s: where every particle whose searches or
+    /// rebuilds can read `i` has its own.
+    pub(crate) fn cells_around(&self, i: usize) -> cells::Around {
+        self.cells.around(&self.cell(i))
+    }
+
+    /// How many cells the grid has.
+    pub(crate) fn cell_count(&self) -> usize {
+        self.cells.counts().iter().product()
+    }
+
     /// How far along `axis` from where a particle last updated its neighbourhood (its list's
     /// centre, or where it entered its cell) the particles its predictions and rebuilds read
     /// last updated theirs, at most. With lists, `R + s/2`: a prediction reads the members

@@ -34,7 +34,10 @@
 //!
 //! [`Divided::run_unordered`] runs the two sides at once in two threads, each applying the
 //! other's changes when they arrive: not a simulation, but what the division costs and
-//! keeps on two cores with nothing spent on the order of time ([`Unordered`]).
+//! keeps on two cores with nothing spent on the order of time ([`Unordered`]) — free, or
+//! each side held within a [`Lead`] of the other — and how often a change arrives late
+//! enough to meet something its receiver has read since, which an engine that keeps the
+//! order would have to undo.
 //!
 //! # Example
 //!
@@ -53,6 +56,7 @@
 
 use super::{Simulation, Taken};
 use crate::engine::geometry::{Boundary, Particle, SimBox};
+use crate::engine::neighbours::Neighbours;
 use crate::engine::params::EngineParams;
 use crate::engine::setup::SetupError;
 use crate::engine::sources::{Event, EventCounts, Outcome};
@@ -332,50 +336,121 @@ impl<const D: usize> Simulation<D> {
         }
     }
 
-    /// One side of [`Divided::run_unordered`]: resolves `per_side` events of its own (or
-    /// until it has none), sending each event's changes to `out` and applying what `inbox`
-    /// holds after each item. Returns the events, the seconds, the batches received and how
-    /// many of them were late.
+    /// One side of [`Divided::run_unordered`]: resolves `per_side` events of its own (until
+    /// it has none, or the other side has resolved as many), sending each event's changes
+    /// to `out` and applying what `inbox` holds after each item, and never taking an item
+    /// more than `lead` allows beyond the other side's next (each side's published in
+    /// `pace`).
     fn run_side(
         &mut self,
         per_side: u64,
         out: &mailbox::Mailbox<Change<D>>,
         inbox: &mailbox::Mailbox<Change<D>>,
-    ) -> (u64, f64, u64, u64) {
+        pace: &Pace,
+        lead: Lead,
+    ) -> SideRun {
+        use std::sync::atomic::Ordering;
+        let me = self.region.as_deref().expect("divided").side as usize;
         let clock = std::time::Instant::now();
-        let (mut events, mut received, mut late) = (0, 0, 0);
+        let mut run = SideRun::default();
+        let mut watch = Watch::new(self.particles.len(), self.neighbours.cell_count());
         let mut batches = mailbox::Batches::default();
-        while events < per_side {
+        // The other side's next item as last read: read again only when this side's would
+        // be beyond it by more than the lead, so that the line it sits on seldom moves.
+        let mut theirs = f64::NEG_INFINITY;
+        let next = &pace.next;
+        run.end = End::Reached;
+        // Consecutive events at one time so far.
+        let mut chain = 0;
+        while run.events < per_side {
+            if pace.stop.load(Ordering::Relaxed) {
+                run.end = End::Halted;
+                break;
+            }
+            let (owner, item) = self.earliest();
+            next[me].0.store(item.time.to_bits(), Ordering::Release);
+            if let Lead::Within(ahead) = lead
+                && item.time > theirs + ahead
+            {
+                theirs = f64::from_bits(next[1 - me].0.load(Ordering::Acquire));
+                if item.time > theirs + ahead {
+                    run.held_back += 1;
+                    self.deliver(inbox, &mut batches, &mut run, &mut watch);
+                    std::hint::spin_loop();
+                    continue;
+                }
+            }
             match self.take() {
-                Taken::Event(_) => events += 1,
-                Taken::Bookkeeping => {}
-                Taken::End => break,
+                Taken::Event(outcome) => {
+                    run.events += 1;
+                    chain = if watch.history.last() == Some(&self.time) { chain + 1 } else { 1 };
+                    run.stall = run.stall.max(chain);
+                    watch.history.push(self.time);
+                    let (a, b) = match outcome {
+                        Outcome::Pair { i, j, .. } => (i, j),
+                        Outcome::Wall { i, .. } | Outcome::Rebuild { i } => (i, i),
+                        Outcome::Sample | Outcome::GrowthEnd => unreachable!("a divided box neither samples"),
+                    };
+                    watch.stamp(&self.neighbours, a, self.time);
+                    watch.stamp(&self.neighbours, b, self.time);
+                }
+                Taken::Bookkeeping => watch.stamp(&self.neighbours, owner as usize, self.time),
+                Taken::End => {
+                    run.end = End::RanOut;
+                    break;
+                }
             }
             let region = self.region.as_deref_mut().expect("divided");
             out.send(&region.outbox);
             region.outbox.clear();
-            let (r, l) = self.deliver(inbox, &mut batches);
-            (received, late) = (received + r, late + l);
+            self.deliver(inbox, &mut batches, &mut run, &mut watch);
         }
-        (events, clock.elapsed().as_secs_f64(), received, late)
+        // The other side stops too (alone, it would run on against this side's particles
+        // frozen where they were) and no longer waits for this one.
+        pace.stop.store(true, Ordering::Relaxed);
+        next[me].0.store(f64::INFINITY.to_bits(), Ordering::Release);
+        run.seconds = clock.elapsed().as_secs_f64();
+        run.clock = watch.history.last().copied().unwrap_or(self.time);
+        run
     }
 
-    /// Applies every batch of changes waiting in `inbox` (taken into `batches`): how many,
-    /// and how many arrived in this side's past.
+    /// Applies every batch of changes waiting in `inbox` (taken into `batches`), counting
+    /// in `run` how they arrived: how many, how many in this side's past, and of those how
+    /// many change a particle that `watch` says was read since (and what undoing back to
+    /// them would take).
     fn deliver(
         &mut self,
         inbox: &mailbox::Mailbox<Change<D>>,
         batches: &mut mailbox::Batches<Change<D>>,
-    ) -> (u64, u64) {
-        let (mut received, mut late) = (0, 0);
-        if inbox.take(batches) {
-            for batch in batches.each() {
-                received += 1;
-                late += u64::from(batch[0].time < self.time);
-                self.receive(batch);
+        run: &mut SideRun,
+        watch: &mut Watch,
+    ) {
+        if !inbox.take(batches) {
+            return;
+        }
+        for batch in batches.each() {
+            run.received += 1;
+            let t = batch[0].time;
+            if t < self.time {
+                run.late += 1;
+                let changed = batch.iter().filter_map(|c| match c.what {
+                    What::Course { k, .. } | What::Neighbourhood { k, .. } => Some(k as usize),
+                    What::Members { .. } | What::Everyone => None,
+                });
+                if changed.clone().any(|k| watch.read_since(&self.neighbours, k, t)) {
+                    run.conflicts += 1;
+                    // Times in the order resolved, which is the order of time but where a
+                    // late batch's predictions came due in this side's past.
+                    run.undone += (watch.history.len() - watch.history.partition_point(|&h| h <= t)) as u64;
+                }
+            }
+            self.receive(batch);
+            for c in batch {
+                if let What::Course { k, .. } | What::Neighbourhood { k, .. } = c.what {
+                    watch.stamp(&self.neighbours, k as usize, t);
+                }
             }
         }
-        (received, late)
     }
 
     /// How many of this side's own particles have a position or velocity that is not a
@@ -402,6 +477,11 @@ impl<const D: usize> Simulation<D> {
 #[derive(Clone, Copy, Debug, PartialEq)]
 #[non_exhaustive]
 pub struct Unordered {
+    /// Why each side stopped, the lower side's first: the first to resolve the events asked
+    /// for stops the other.
+    pub end: [End; 2],
+    /// The time of each side's last event, the lower side's first.
+    pub clocks: [f64; 2],
     /// Events each side resolved (re-prediction markers not counted), the lower side's first.
     pub events: [u64; 2],
     /// Each side's thread's time from the start to its last event, in seconds.
@@ -423,6 +503,121 @@ pub struct Unordered {
     pub disowned: usize,
     /// How many particles each side holds for its own at the end.
     pub held: [usize; 2],
+    /// How many of the late batches each side received change a particle it read after the
+    /// batch's time: one of its own events' particles, a particle it predicted, or one whose
+    /// searches read it (a change it applied from an earlier batch counts as read at that
+    /// batch's time). An engine that keeps the order of time has to undo its events back to
+    /// such a batch; a late batch that changes nothing read since can be applied as it comes.
+    pub conflicts: [u64; 2],
+    /// The side's own events later than each conflicting batch, summed: the events an
+    /// engine that keeps the order would undo and resolve again (cascades not counted).
+    pub undone: [u64; 2],
+    /// How often each side stood waiting because its next item lay beyond the lead.
+    pub held_back: [u64; 2],
+    /// The longest chain of each side's consecutive events at one time. The whole box's
+    /// events at one time are rare and few; here a collision across the border that both
+    /// sides resolved (each before it heard of the other's) makes two, and particles left
+    /// overlapping by the disorder a chain that stops the clock (a measurement with one is
+    /// void).
+    pub stall: [u64; 2],
+}
+
+/// How far ahead of the other side a side of [`Divided::run_unordered`] may run, in the
+/// time of the simulation.
+#[derive(Clone, Copy, Debug, PartialEq)]
+#[non_exhaustive]
+pub enum Lead {
+    /// As far as it goes: each side resolves its events at its own pace.
+    Free,
+    /// No item later than this long after the other side's next: a side that would go
+    /// further waits, applying what arrives. Two sides can never both wait (each waits
+    /// only for an item earlier than its own by the lead).
+    Within(f64),
+}
+
+/// A side's next item's time (its bits) on a cache line of its own, which the other side
+/// reads.
+#[repr(align(128))]
+struct Line(std::sync::atomic::AtomicU64);
+
+/// What the sides of [`Divided::run_unordered`] share besides their changes: each side's
+/// next item's time, and whether one has stopped.
+struct Pace {
+    next: [Line; 2],
+    stop: std::sync::atomic::AtomicBool,
+}
+
+/// Why a side of [`Divided::run_unordered`] stopped.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+#[non_exhaustive]
+pub enum End {
+    /// It resolved the events asked for.
+    #[default]
+    Reached,
+    /// The other side had resolved them first (or ran out).
+    Halted,
+    /// It had no event left: every particle of its own had gone to the other side.
+    RanOut,
+}
+
+/// What one side of [`Divided::run_unordered`] counted.
+#[derive(Clone, Copy, Debug, Default)]
+struct SideRun {
+    end: End,
+    clock: f64,
+    events: u64,
+    seconds: f64,
+    received: u64,
+    late: u64,
+    conflicts: u64,
+    undone: u64,
+    held_back: u64,
+    stall: u64,
+}
+
+/// What a side of [`Divided::run_unordered`] has read: for each particle the latest time
+/// at which an item of this side read it (its events' particles, whose predictions read
+/// their neighbours) or a change was applied to it, the same for each cell of the grid
+/// (the latest of its particles', when they were stamped: a filter), and the times of the
+/// side's events.
+struct Watch {
+    particles: Vec<f64>,
+    cells: Vec<f64>,
+    history: Vec<f64>,
+}
+
+impl Watch {
+    fn new(particles: usize, cells: usize) -> Self {
+        Watch {
+            particles: vec![f64::NEG_INFINITY; particles],
+            cells: vec![f64::NEG_INFINITY; cells],
+            history: Vec::new(),
+        }
+    }
+
+    /// Particle `k` was read at `t` (where the neighbourhood has it now).
+    fn stamp<const D: usize>(&mut self, neighbours: &Neighbours<D>, k: usize, t: f64) {
+        self.particles[k] = self.particles[k].max(t);
+        let c = neighbours.cell_index(k);
+        self.cells[c] = self.cells[c].max(t);
+    }
+
+    /// Whether `k`, or a particle whose searches read `k`, was read after `t`. Every reader
+    /// of `k` has its cell next to `k`'s, and a particle's present cell was stamped when it
+    /// was (it moves cell only at a stamp of its own), so only the cells around `k`'s
+    /// stamped after `t` are looked into.
+    fn read_since<const D: usize>(&self, neighbours: &Neighbours<D>, k: usize, t: f64) -> bool {
+        if self.particles[k] > t {
+            return true;
+        }
+        neighbours.cells_around(k).as_slice().iter().any(|&c| {
+            self.cells[c as usize] > t
+                && neighbours
+                    .cells()
+                    .members(c)
+                    .any(|i| self.particles[i as usize] > t && neighbours.searches(i as usize, k))
+        })
+    }
 }
 
 impl Unordered {
@@ -557,31 +752,44 @@ impl<const D: usize> Divided<D> {
         })
     }
 
-    /// Runs both sides at once, each in its own thread until it has resolved `per_side`
-    /// events, each applying the other's changes when they arrive instead of in the order of
-    /// time: a measurement of what the division costs and keeps on two cores with nothing
-    /// spent on keeping the order — an upper bound on an engine that keeps it. Not a
-    /// simulation: the sides' replicas no longer agree, and the events are not the whole
-    /// box's, so the divided box is consumed.
-    pub fn run_unordered(self, per_side: u64) -> Unordered {
+    /// Runs both sides at once, each in its own thread, until one has resolved `per_side`
+    /// events (or has none left), each applying the other's changes when they arrive instead
+    /// of in the order of time and none going further ahead of the other than `lead` allows:
+    /// a measurement of what the division costs and keeps on two cores with nothing spent on
+    /// keeping the order — an upper bound on an engine that keeps it — and of what such an
+    /// engine would undo ([`Unordered::conflicts`]). Not a simulation: the sides' replicas no
+    /// longer agree, and the events are not the whole box's, so the divided box is consumed.
+    pub fn run_unordered(self, per_side: u64, lead: Lead) -> Unordered {
+        use std::sync::atomic::AtomicU64;
         let [mut lower, mut upper] = self.sides;
         let mailboxes = [mailbox::Mailbox::default(), mailbox::Mailbox::default()];
         let [to_lower, to_upper] = &mailboxes;
+        let pace = Pace {
+            next: [Line(AtomicU64::new(0)), Line(AtomicU64::new(0))],
+            stop: std::sync::atomic::AtomicBool::new(false),
+        };
         let [a, b] = std::thread::scope(|scope| {
-            let thread = scope.spawn(|| lower.run_side(per_side, to_upper, to_lower));
-            let here = upper.run_side(per_side, to_lower, to_upper);
+            let thread = scope.spawn(|| lower.run_side(per_side, to_upper, to_lower, &pace, lead));
+            let here = upper.run_side(per_side, to_lower, to_upper, &pace, lead);
             [thread.join().expect("the lower side's thread"), here]
         });
         // What a side sent after the other had stopped (a particle given away, say) is
         // applied now, so that the end state counts only what the disorder did.
         let mut batches = mailbox::Batches::default();
-        lower.deliver(to_lower, &mut batches);
-        upper.deliver(to_upper, &mut batches);
+        let mut watch = Watch::new(lower.particles.len(), lower.neighbours.cell_count());
+        lower.deliver(to_lower, &mut batches, &mut SideRun::default(), &mut watch);
+        upper.deliver(to_upper, &mut batches, &mut SideRun::default(), &mut watch);
         Unordered {
-            events: [a.0, b.0],
-            seconds: [a.1, b.1],
-            received: [a.2, b.2],
-            late: [a.3, b.3],
+            end: [a.end, b.end],
+            clocks: [a.clock, b.clock],
+            events: [a.events, b.events],
+            seconds: [a.seconds, b.seconds],
+            received: [a.received, b.received],
+            late: [a.late, b.late],
+            conflicts: [a.conflicts, b.conflicts],
+            undone: [a.undone, b.undone],
+            held_back: [a.held_back, b.held_back],
+            stall: [a.stall, b.stall],
             not_numbers: [lower.not_numbers(), upper.not_numbers()],
             disowned: (0..lower.particles.len()).filter(|&k| !lower.owns(k) && !upper.owns(k)).count(),
             held: [lower.held(), upper.held()],

@@ -78,19 +78,83 @@ fn walled_mixtures() {
     same_events(particles, sim_box, Neighbourhood::Grid, 100_000);
 }
 
-/// Two threads, changes applied on arrival: each side resolves the events asked of it, the
-/// two tell each other what changed (some of it in the receiver's past, as the sides run
-/// at once), and the measure is a rate; once both have applied everything, every particle
-/// is one side's. Checked to fail: with the sending left out, nothing is received; without
-/// applying what was sent after a side stopped, particles in hand-over were disowned (in one
-/// run of three); at
-/// N = 2048, where nearly everything is near a border, a side runs out of events.
+/// Two threads, changes applied on arrival: the first side to resolve the events asked of
+/// it stops the other, the two tell each other what changed (some of it in the receiver's
+/// past, as the sides run at once), and the measure is a rate; once both have applied
+/// everything, every particle is one side's. Checked to fail: with the sending left out,
+/// nothing is received; without applying what was sent after a side stopped, particles in
+/// hand-over were disowned (in one run of three); at N = 2048, where nearly everything is
+/// near a border, a side runs out of events.
 #[test]
 fn two_threads_unordered() {
     let (particles, sim_box) = bench_start::<3>(10_976, 0.45);
-    let run = Divided::new(particles, sim_box).expect("a valid start").run_unordered(100_000);
-    assert_eq!((run.events, run.not_numbers, run.disowned), ([100_000; 2], [0; 2], 0), "{run:?}");
+    let run = Divided::new(particles, sim_box).expect("a valid start").run_unordered(100_000, Lead::Free);
+    assert!(run.end.contains(&End::Reached) && !run.end.contains(&End::RanOut), "{run:?}");
+    assert_eq!(run.events.iter().max(), Some(&100_000), "{run:?}");
+    assert!(run.events.iter().all(|&e| e > 50_000), "{run:?}");
+    assert_eq!((run.not_numbers, run.disowned), ([0; 2], 0), "{run:?}");
     assert!(run.received.iter().all(|&r| r > 5_000), "{run:?}");
-    assert!(run.late.iter().zip(&run.received).all(|(l, r)| l <= r), "{run:?}");
+    let ordered = |a: &[u64; 2], b: &[u64; 2]| a.iter().zip(b).all(|(x, y)| x <= y);
+    assert!(ordered(&run.conflicts, &run.late) && ordered(&run.late, &run.received), "{run:?}");
     assert!(run.seconds.iter().all(|&s| s > 0.0) && run.rate().is_finite(), "{run:?}");
+}
+
+/// Held within a lead of two of the whole box's mean times between events, the sides'
+/// last events lie within the lead and a few more such times of each other (an item is
+/// taken only within the lead of the other side's next as last read; the gaps seen were
+/// 0.3–7.6 of those times), and the sides stood waiting. Checked to fail: free, the same
+/// start ended with the last events 20 to 860 such times apart in six runs (beyond the
+/// bound in five), and no side ever waits.
+#[test]
+fn two_threads_within_a_lead() {
+    let (particles, sim_box) = bench_start::<3>(10_976, 0.45);
+    let mut whole = Simulation::new(particles.clone(), sim_box.clone()).expect("a valid start");
+    for _ in 0..50_000 {
+        whole.step().expect("events go on");
+    }
+    let interval = whole.time() / 50_000.0;
+    let lead = 2.0 * interval;
+    let run = Divided::new(particles, sim_box).expect("a valid start").run_unordered(100_000, Lead::Within(lead));
+    assert!(!run.end.contains(&End::RanOut) && run.not_numbers == [0; 2], "{run:?}");
+    assert!((run.clocks[0] - run.clocks[1]).abs() < lead + 30.0 * interval, "{run:?}, lead {lead}");
+    assert!(run.held_back.iter().any(|&h| h > 0), "{run:?}");
+}
+
+/// A late change meets a read exactly when the changed particle, or one whose searches
+/// read it, was read after the change's time: not at the time itself, not before, and not
+/// by a particle out of range. Checked to fail: with the range left out (a particle in the
+/// cells around, out of range, met it), with the changed particle's own read at the
+/// change's time counted, and with the cells' filter turned round.
+#[test]
+fn late_changes_meet_the_reads_since() {
+    let (particles, sim_box) = bench_start::<3>(2048, 0.45);
+    let sim = Simulation::new(particles, sim_box).expect("a valid start");
+    let neighbours = &sim.neighbours;
+    let n = sim.particles.len();
+    let k = 7;
+    let reader = neighbours.candidates(k).find(|&i| i != k && neighbours.searches(i, k)).expect("a neighbour");
+    let far = (0..n)
+        .find(|&i| {
+            neighbours
+                .cells_around(k)
+                .as_slice()
+                .iter()
+                .all(|&c| neighbours.cells().members(c).all(|m| m as usize != i))
+        })
+        .expect("a far particle");
+    let beside = neighbours
+        .cells_around(k)
+        .as_slice()
+        .iter()
+        .flat_map(|&c| neighbours.cells().members(c))
+        .map(|m| m as usize)
+        .find(|&i| !neighbours.searches(i, k))
+        .expect("a particle in the cells around, out of range");
+    let fresh = || Watch::new(n, neighbours.cell_count());
+    let cases = [(k, 2.0, true), (k, 1.0, false), (reader, 2.0, true), (reader, 1.0, false), (reader, 0.5, false)];
+    for (who, at, meets) in cases.into_iter().chain([(beside, 2.0, false), (far, 2.0, false)]) {
+        let mut watch = fresh();
+        watch.stamp(neighbours, who, at);
+        assert_eq!(watch.read_since(neighbours, k, 1.0), meets, "read of {who} at {at}");
+    }
 }
