@@ -431,6 +431,7 @@ impl<const D: usize> Simulation<D> {
         for batch in batches.each() {
             run.received += 1;
             let t = batch[0].time;
+            let mut quiet = false;
             if t < self.time {
                 run.late += 1;
                 let changed = batch.iter().filter_map(|c| match c.what {
@@ -442,9 +443,14 @@ impl<const D: usize> Simulation<D> {
                     // Times in the order resolved, which is the order of time but where a
                     // late batch's predictions came due in this side's past.
                     run.undone += (watch.history.len() - watch.history.partition_point(|&h| h <= t)) as u64;
+                } else {
+                    quiet = true;
                 }
             }
             self.receive(batch);
+            if quiet && watch.history.last().is_some_and(|&last| self.earliest().1.time < last) {
+                run.overtaken += 1;
+            }
             for c in batch {
                 if let What::Course { k, .. } | What::Neighbourhood { k, .. } = c.what {
                     watch.stamp(&self.neighbours, k as usize, t);
@@ -512,6 +518,12 @@ pub struct Unordered {
     /// The side's own events later than each conflicting batch, summed: the events an
     /// engine that keeps the order would undo and resolve again (cascades not counted).
     pub undone: [u64; 2],
+    /// How many of the late batches each side received met no read, but predicted an event
+    /// of its own earlier than its last: applied as they come, they put an event into the
+    /// receiver's past, which an engine that keeps the order has to resolve there (nothing
+    /// since has read its particles, or the batch would have met a read; but what the event
+    /// changes may) or undo back to.
+    pub overtaken: [u64; 2],
     /// How often each side stood waiting because its next item lay beyond the lead.
     pub held_back: [u64; 2],
     /// The longest chain of each side's consecutive events at one time. The whole box's
@@ -573,6 +585,7 @@ struct SideRun {
     undone: u64,
     held_back: u64,
     stall: u64,
+    overtaken: u64,
 }
 
 /// What a side of [`Divided::run_unordered`] has read: for each particle the latest time
@@ -788,6 +801,7 @@ impl<const D: usize> Divided<D> {
             late: [a.late, b.late],
             conflicts: [a.conflicts, b.conflicts],
             undone: [a.undone, b.undone],
+            overtaken: [a.overtaken, b.overtaken],
             held_back: [a.held_back, b.held_back],
             stall: [a.stall, b.stall],
             not_numbers: [lower.not_numbers(), upper.not_numbers()],

@@ -96,6 +96,8 @@ fn two_threads_unordered() {
     assert!(run.received.iter().all(|&r| r > 5_000), "{run:?}");
     let ordered = |a: &[u64; 2], b: &[u64; 2]| a.iter().zip(b).all(|(x, y)| x <= y);
     assert!(ordered(&run.conflicts, &run.late) && ordered(&run.late, &run.received), "{run:?}");
+    let quiet = [run.late[0] - run.conflicts[0], run.late[1] - run.conflicts[1]];
+    assert!(ordered(&run.overtaken, &quiet), "{run:?}");
     assert!(run.seconds.iter().all(|&s| s > 0.0) && run.rate().is_finite(), "{run:?}");
 }
 
