@@ -58,7 +58,7 @@
 //! With `--test` (as `cargo bench -- --test` runs every bench) it checks the schedule on
 //! cases with known answers and replays a small system.
 
-use collide::engine::{Divided, End, Lead, Outcome, RANGE_HOLDS_3D, SimBox, Simulation};
+use collide::engine::{Divided, Lead, Outcome, RANGE_HOLDS_3D, SimBox, Simulation, Stop};
 use nalgebra::Vector3;
 
 /// Packing fraction of the replayed fluid.
@@ -479,7 +479,7 @@ fn two_threads(sim: &Simulation<3>, events: u64) {
             // (its events lost) or a chain of collisions that stops the clock (particles
             // overlapping) makes the round no measurement.
             let stall = run.stall[0].max(run.stall[1]);
-            let why = if run.end.contains(&End::RanOut) {
+            let why = if run.stops.contains(&Stop::RanOut) {
                 Some(format!("a side ran out of events ({:?}, holding {:?})", run.events, run.held))
             } else if run.not_numbers != [0; 2] {
                 Some(format!("{} states not numbers", run.not_numbers[0] + run.not_numbers[1]))

@@ -359,12 +359,12 @@ impl<const D: usize> Simulation<D> {
         // be beyond it by more than the lead, so that the line it sits on seldom moves.
         let mut theirs = f64::NEG_INFINITY;
         let next = &pace.next;
-        run.end = End::Reached;
+        run.stop = Stop::Reached;
         // Consecutive events at one time so far.
         let mut chain = 0;
         while run.events < per_side {
             if pace.stop.load(Ordering::Relaxed) {
-                run.end = End::Halted;
+                run.stop = Stop::Halted;
                 break;
             }
             let (owner, item) = self.earliest();
@@ -396,7 +396,7 @@ impl<const D: usize> Simulation<D> {
                 }
                 Taken::Bookkeeping => watch.stamp(&self.neighbours, owner as usize, self.time),
                 Taken::End => {
-                    run.end = End::RanOut;
+                    run.stop = Stop::RanOut;
                     break;
                 }
             }
@@ -485,7 +485,7 @@ impl<const D: usize> Simulation<D> {
 pub struct Unordered {
     /// Why each side stopped, the lower side's first: the first to resolve the events asked
     /// for stops the other.
-    pub end: [End; 2],
+    pub stops: [Stop; 2],
     /// The time of each side's last event, the lower side's first.
     pub clocks: [f64; 2],
     /// Events each side resolved (re-prediction markers not counted), the lower side's first.
@@ -562,7 +562,7 @@ struct Pace {
 /// Why a side of [`Divided::run_unordered`] stopped.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 #[non_exhaustive]
-pub enum End {
+pub enum Stop {
     /// It resolved the events asked for.
     #[default]
     Reached,
@@ -575,7 +575,7 @@ pub enum End {
 /// What one side of [`Divided::run_unordered`] counted.
 #[derive(Clone, Copy, Debug, Default)]
 struct SideRun {
-    end: End,
+    stop: Stop,
     clock: f64,
     events: u64,
     seconds: f64,
@@ -793,7 +793,7 @@ impl<const D: usize> Divided<D> {
         lower.deliver(to_lower, &mut batches, &mut SideRun::default(), &mut watch);
         upper.deliver(to_upper, &mut batches, &mut SideRun::default(), &mut watch);
         Unordered {
-            end: [a.end, b.end],
+            stops: [a.stop, b.stop],
             clocks: [a.clock, b.clock],
             events: [a.events, b.events],
             seconds: [a.seconds, b.seconds],

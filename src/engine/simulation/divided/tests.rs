@@ -89,7 +89,7 @@ fn walled_mixtures() {
 fn two_threads_unordered() {
     let (particles, sim_box) = bench_start::<3>(10_976, 0.45);
     let run = Divided::new(particles, sim_box).expect("a valid start").run_unordered(100_000, Lead::Free);
-    assert!(run.end.contains(&End::Reached) && !run.end.contains(&End::RanOut), "{run:?}");
+    assert!(run.stops.contains(&Stop::Reached) && !run.stops.contains(&Stop::RanOut), "{run:?}");
     assert_eq!(run.events.iter().max(), Some(&100_000), "{run:?}");
     assert!(run.events.iter().all(|&e| e > 50_000), "{run:?}");
     assert_eq!((run.not_numbers, run.disowned), ([0; 2], 0), "{run:?}");
@@ -117,7 +117,7 @@ fn two_threads_within_a_lead() {
     let interval = whole.time() / 50_000.0;
     let lead = 2.0 * interval;
     let run = Divided::new(particles, sim_box).expect("a valid start").run_unordered(100_000, Lead::Within(lead));
-    assert!(!run.end.contains(&End::RanOut) && run.not_numbers == [0; 2], "{run:?}");
+    assert!(!run.stops.contains(&Stop::RanOut) && run.not_numbers == [0; 2], "{run:?}");
     assert!((run.clocks[0] - run.clocks[1]).abs() < lead + 30.0 * interval, "{run:?}, lead {lead}");
     assert!(run.held_back.iter().any(|&h| h > 0), "{run:?}");
 }
