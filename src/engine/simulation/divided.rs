@@ -124,6 +124,14 @@ enum What<const D: usize> {
     Everyone,
 }
 
+/// The particles whose state a batch of changes sets.
+fn changed<const D: usize>(batch: &[Change<D>]) -> impl Iterator<Item = usize> + '_ {
+    batch.iter().filter_map(|c| match c.what {
+        What::Course { k, .. } | What::Neighbourhood { k, .. } => Some(k as usize),
+        What::Members { .. } | What::Everyone => None,
+    })
+}
+
 /// How many list members one [`What::Members`] carries: as many as fit in the room a
 /// state takes, so that the change is no larger.
 const CHUNK: usize = 16;
@@ -434,11 +442,7 @@ impl<const D: usize> Simulation<D> {
             let mut quiet = false;
             if t < self.time {
                 run.late += 1;
-                let changed = batch.iter().filter_map(|c| match c.what {
-                    What::Course { k, .. } | What::Neighbourhood { k, .. } => Some(k as usize),
-                    What::Members { .. } | What::Everyone => None,
-                });
-                if changed.clone().any(|k| watch.read_since(&self.neighbours, k, t)) {
+                if changed(batch).any(|k| watch.read_since(&self.neighbours, k, t)) {
                     run.conflicts += 1;
                     // Times in the order resolved, which is the order of time but where a
                     // late batch's predictions came due in this side's past.
@@ -451,10 +455,8 @@ impl<const D: usize> Simulation<D> {
             if quiet && watch.history.last().is_some_and(|&last| self.earliest().1.time < last) {
                 run.overtaken += 1;
             }
-            for c in batch {
-                if let What::Course { k, .. } | What::Neighbourhood { k, .. } = c.what {
-                    watch.stamp(&self.neighbours, k as usize, t);
-                }
+            for k in changed(batch) {
+                watch.stamp(&self.neighbours, k, t);
             }
         }
     }
