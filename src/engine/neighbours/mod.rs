@@ -38,6 +38,7 @@
 
 pub(crate) mod cells;
 pub(crate) mod lists;
+mod undo;
 
 use crate::engine::arrays::Store;
 use crate::engine::geometry::{Boundary, Particle, SimBox};
@@ -133,6 +134,8 @@ pub struct Neighbours<const D: usize> {
     sim_box: SimBox<D>,
     /// A rebuild's new neighbours (kept, so that no rebuild allocates once warmed up).
     scratch: Vec<u32>,
+    /// The changes made since recording began, when asked for ([`Neighbours::record`]).
+    log: Option<Vec<undo::Undo<D>>>,
 }
 
 /// How a saved [`Neighbours`] is restored: the grid's unwrapped cell coordinates, or the
@@ -208,6 +211,7 @@ impl<const D: usize> Neighbours<D> {
             bound2: 0.0,
             sim_box: *sim_box,
             scratch: Vec::new(),
+            log: None,
         }
     }
 
@@ -388,10 +392,13 @@ impl<const D: usize> Neighbours<D> {
             let rows = Self::ROWS;
             for j in self.cells.neighbours(from) {
                 if j != i {
-                    lists::drop(&mut self.lists[j * rows..(j + 1) * rows], i as u32);
+                    let row = &mut self.lists[j * rows..(j + 1) * rows];
+                    undo::note_holding(&mut self.log, j, row, i);
+                    lists::drop(row, i as u32);
                 }
             }
             for &j in &found {
+                self.note_rows(j as usize);
                 lists::add(self.rows_mut(j as usize), i as u32);
             }
         } else {
@@ -402,16 +409,19 @@ impl<const D: usize> Neighbours<D> {
                 let stays =
                     if found.len() <= new.len() { new.contains(&(j as u32)) } else { found.contains(&(j as u32)) };
                 if !stays {
+                    self.note_rows(j);
                     lists::drop(self.rows_mut(j), i as u32);
                 }
             }
             let before = lists::block(old.entries());
             for &j in &found {
                 if !before.contains(&j) {
+                    self.note_rows(j as usize);
                     lists::add(self.rows_mut(j as usize), i as u32);
                 }
             }
         }
+        self.note_rows(i);
         lists::fill(self.rows_mut(i), &found);
         self.scratch = found;
     }
@@ -449,12 +459,15 @@ impl<const D: usize> Neighbours<D> {
             let rows = Self::ROWS;
             for j in self.cells.neighbours(from) {
                 if j != i && mine(j) {
-                    lists::drop(&mut self.lists[j * rows..(j + 1) * rows], i as u32);
+                    let row = &mut self.lists[j * rows..(j + 1) * rows];
+                    undo::note_holding(&mut self.log, j, row, i);
+                    lists::drop(row, i as u32);
                 }
             }
         } else {
             for j in old.members() {
                 if mine(j) && !found.contains(&(j as u32)) {
+                    self.note_rows(j);
                     lists::drop(self.rows_mut(j), i as u32);
                 }
             }
@@ -462,9 +475,11 @@ impl<const D: usize> Neighbours<D> {
         for &j in &found {
             let j = j as usize;
             if (joins || mine(j)) && !Rows(self.rows(j)).entries().any(|k| k == i as u32) {
+                self.note_rows(j);
                 lists::add(self.rows_mut(j), i as u32);
             }
         }
+        self.note_rows(i);
         lists::fill(self.rows_mut(i), &found);
         self.scratch = found;
     }
@@ -477,6 +492,7 @@ impl<const D: usize> Neighbours<D> {
         if !self.listed {
             let (_, axis, up) =
                 self.cells.next_crossing(&self.cells.coord(i), &p.position, &p.velocity).expect("a crossing");
+            self.note(undo::Undo::Shift { k: i as u32, axis: axis as u8, up });
             self.cells.shift(i, axis, up);
             return None;
         }
@@ -491,6 +507,7 @@ impl<const D: usize> Neighbours<D> {
         let mut old = [List::EMPTY; lists::MAX_ROWS];
         old[..Self::ROWS].copy_from_slice(self.rows(i));
         let from = self.cell(i);
+        self.note(undo::Undo::Centre { k: i as u32, centre: self.centres[i] });
         let centre = p.position_at(t);
         let to = self.cells.locate(&centre);
         if from != to {

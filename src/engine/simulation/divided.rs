@@ -81,6 +81,8 @@ pub(crate) struct Region<const D: usize> {
     outbox: Vec<Change<D>>,
     /// Changes told so far (a list's members counted with its `Neighbourhood` change).
     told: u64,
+    /// What each item changed, when recording ([`journal`]).
+    journal: Option<Vec<journal::Record<D>>>,
 }
 
 /// A slab.
@@ -149,6 +151,7 @@ impl<const D: usize> Region<D> {
             zone,
             outbox: Vec::new(),
             told: 0,
+            journal: None,
         }
     }
 
@@ -298,6 +301,7 @@ impl<const D: usize> Simulation<D> {
     /// slab).
     fn receive(&mut self, changes: &[Change<D>]) {
         let Some(first) = changes.first() else { return };
+        self.note_batch(changes);
         self.time = first.time;
         for (at, change) in changes.iter().enumerate() {
             match change.what {
@@ -388,7 +392,7 @@ impl<const D: usize> Simulation<D> {
                     continue;
                 }
             }
-            match self.take() {
+            match self.take_noted() {
                 Taken::Event(outcome) => {
                     run.events += 1;
                     chain = if watch.history.last() == Some(&self.time) { chain + 1 } else { 1 };
@@ -692,7 +696,7 @@ impl<const D: usize> Divided<D> {
                 ([a, b], [ea, eb])
             };
             let s = first_b.before(b, &first_a, a) as usize;
-            let taken = self.sides[s].take();
+            let taken = self.sides[s].take_noted();
             let region = self.sides[s].region.as_deref_mut().expect("divided");
             std::mem::swap(&mut self.mail, &mut region.outbox);
             self.sides[1 - s].receive(&self.mail);
@@ -702,6 +706,24 @@ impl<const D: usize> Divided<D> {
                 Taken::Bookkeeping => continue,
                 Taken::End => return None,
             }
+        }
+    }
+
+    /// Starts (or stops and forgets) recording on both sides what each item changes, so
+    /// that the divided box can be taken back ([`undo_to`](Self::undo_to)).
+    pub(crate) fn record(&mut self, on: bool) {
+        self.sides.iter_mut().for_each(|s| s.record(on));
+    }
+
+    /// Where both sides' records stand now.
+    pub(crate) fn mark(&self) -> [journal::Mark; 2] {
+        self.sides.each_ref().map(|s| s.mark())
+    }
+
+    /// Takes both sides back to where [`mark`](Self::mark) gave `mark`.
+    pub(crate) fn undo_to(&mut self, mark: [journal::Mark; 2]) {
+        for (side, mark) in self.sides.iter_mut().zip(mark) {
+            side.undo_to(mark);
         }
     }
 
@@ -813,6 +835,7 @@ impl<const D: usize> Divided<D> {
     }
 }
 
+mod journal;
 mod mailbox;
 #[cfg(test)]
 mod tests;
