@@ -711,16 +711,19 @@ impl<const D: usize> Divided<D> {
 
     /// Starts (or stops and forgets) recording on both sides what each item changes, so
     /// that the divided box can be taken back ([`undo_to`](Self::undo_to)).
+    #[cfg_attr(not(test), allow(dead_code))]
     pub(crate) fn record(&mut self, on: bool) {
         self.sides.iter_mut().for_each(|s| s.record(on));
     }
 
     /// Where both sides' records stand now.
+    #[cfg_attr(not(test), allow(dead_code))]
     pub(crate) fn mark(&self) -> [journal::Mark; 2] {
         self.sides.each_ref().map(|s| s.mark())
     }
 
     /// Takes both sides back to where [`mark`](Self::mark) gave `mark`.
+    #[cfg_attr(not(test), allow(dead_code))]
     pub(crate) fn undo_to(&mut self, mark: [journal::Mark; 2]) {
         for (side, mark) in self.sides.iter_mut().zip(mark) {
             side.undo_to(mark);
