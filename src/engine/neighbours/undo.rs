@@ -44,10 +44,8 @@ impl<const D: usize> Neighbours<D> {
     /// Records particle `k`'s rows before they change.
     #[inline]
     pub(super) fn note_rows(&mut self, k: usize) {
-        if self.log.is_some() {
-            let mut rows = [List::EMPTY; MAX_ROWS];
-            rows[..Self::ROWS].copy_from_slice(self.rows(k));
-            self.log.as_mut().expect("recording").push(Undo::Rows { k: k as u32, rows });
+        if let Some(log) = &mut self.log {
+            log.push(Undo::rows(k, &self.lists[k * Self::ROWS..(k + 1) * Self::ROWS]));
         }
     }
 
@@ -93,8 +91,15 @@ pub(super) fn note_holding<const D: usize>(log: &mut Option<Vec<Undo<D>>>, k: us
     if let Some(log) = log
         && rows.iter().any(|row| row.entries().contains(&(i as u32)))
     {
+        log.push(Undo::rows(k, rows));
+    }
+}
+
+impl<const D: usize> Undo<D> {
+    /// Particle `k`'s rows `rows`, as they are.
+    fn rows(k: usize, rows: &[List]) -> Self {
         let mut saved = [List::EMPTY; MAX_ROWS];
         saved[..rows.len()].copy_from_slice(rows);
-        log.push(Undo::Rows { k: k as u32, rows: saved });
+        Undo::Rows { k: k as u32, rows: saved }
     }
 }

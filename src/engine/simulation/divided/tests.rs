@@ -6,6 +6,27 @@ use super::*;
 use crate::engine::init::{Placement, Species, Velocities, box_for_packing_fraction, initial_particles};
 use crate::engine::{Boundary, Neighbourhood};
 
+/// The whole box and the divided one from the same start, with `neighbourhood`.
+fn whole_and_divided<const D: usize>(
+    particles: Vec<Particle<D>>,
+    sim_box: SimBox<D>,
+    neighbourhood: Neighbourhood,
+) -> (Simulation<D>, Divided<D>) {
+    let params = EngineParams::with_neighbourhood(neighbourhood);
+    let whole = Simulation::with_params(particles.clone(), sim_box.clone(), params).expect("a valid start");
+    (whole, Divided::with_params(particles, sim_box, params).expect("a valid start"))
+}
+
+/// 300 spheres and 200 smaller, lighter ones at η = 0.3, walls on every axis, in a box six
+/// times as long on the axis divided as on the others.
+fn walled_mixture() -> (Vec<Particle<3>>, SimBox<3>) {
+    let species = [Species { count: 300, radius: 0.5, mass: 1.0 }, Species { count: 200, radius: 0.3, mass: 0.4 }];
+    let sim_box =
+        box_for_packing_fraction::<3>(&species, 0.3, [Boundary::Wall; 3], Placement::Random, Some([6.0, 1.0, 1.0]));
+    let particles = initial_particles(&species, &sim_box, Placement::Random, Velocities::Maxwell, 1.0, 4).unwrap();
+    (particles, sim_box)
+}
+
 /// Runs `steps` events of the whole box and the divided one side by side: every outcome
 /// equal, then the counts (re-prediction markers included) and the particles; the
 /// replicas agree; both slabs hold particles, and some changed side. Returns how many did.
@@ -15,9 +36,7 @@ fn same_events<const D: usize>(
     neighbourhood: Neighbourhood,
     steps: u64,
 ) -> usize {
-    let params = EngineParams::with_neighbourhood(neighbourhood);
-    let mut whole = Simulation::with_params(particles.clone(), sim_box.clone(), params).expect("a valid start");
-    let mut divided = Divided::with_params(particles, sim_box, params).expect("a valid start");
+    let (mut whole, mut divided) = whole_and_divided(particles, sim_box, neighbourhood);
     let start = divided.sides[0].region.as_deref().expect("divided").owner.clone();
     assert!(divided.sides().iter().all(|&n| n > 0), "{:?}", divided.sides());
     for k in 0..steps {
@@ -67,11 +86,9 @@ fn dense_disks() {
 /// in boxes long on the axis divided.
 #[test]
 fn walled_mixtures() {
-    let species = [Species { count: 300, radius: 0.5, mass: 1.0 }, Species { count: 200, radius: 0.3, mass: 0.4 }];
-    let sim_box =
-        box_for_packing_fraction::<3>(&species, 0.3, [Boundary::Wall; 3], Placement::Random, Some([6.0, 1.0, 1.0]));
-    let particles = initial_particles(&species, &sim_box, Placement::Random, Velocities::Maxwell, 1.0, 4).unwrap();
+    let (particles, sim_box) = walled_mixture();
     same_events(particles, sim_box, Neighbourhood::Lists, 100_000);
+    let species = [Species { count: 300, radius: 0.5, mass: 1.0 }, Species { count: 200, radius: 0.3, mass: 0.4 }];
     let sim_box =
         box_for_packing_fraction::<2>(&species, 0.5, [Boundary::Wall; 2], Placement::Random, Some([4.0, 1.0]));
     let particles = initial_particles(&species, &sim_box, Placement::Random, Velocities::Maxwell, 1.0, 4).unwrap();
@@ -199,9 +216,7 @@ fn undo_replays<const D: usize>(
     stretches: usize,
 ) -> f64 {
     use rand::{RngExt, SeedableRng};
-    let params = EngineParams::with_neighbourhood(neighbourhood);
-    let mut whole = Simulation::with_params(particles.clone(), sim_box.clone(), params).expect("a valid start");
-    let mut divided = Divided::with_params(particles, sim_box, params).expect("a valid start");
+    let (mut whole, mut divided) = whole_and_divided(particles, sim_box, neighbourhood);
     let mut rng = rand::rngs::StdRng::seed_from_u64(11);
     let (mut most, mut rebuilds) = (0.0f64, 0);
     for stretch in 0..stretches {
@@ -238,10 +253,7 @@ fn undone_events_replay_bit_for_bit() {
         let (particles, sim_box) = bench_start::<2>(2000, 0.65);
         undo_replays(particles, sim_box, neighbourhood, 25);
     }
-    let species = [Species { count: 300, radius: 0.5, mass: 1.0 }, Species { count: 200, radius: 0.3, mass: 0.4 }];
-    let sim_box =
-        box_for_packing_fraction::<3>(&species, 0.3, [Boundary::Wall; 3], Placement::Random, Some([6.0, 1.0, 1.0]));
-    let particles = initial_particles(&species, &sim_box, Placement::Random, Velocities::Maxwell, 1.0, 4).unwrap();
+    let (particles, sim_box) = walled_mixture();
     let per_event = undo_replays(particles, sim_box, Neighbourhood::Lists, 25);
     assert!(per_event < 20.0, "{per_event} records an event");
 }
