@@ -46,7 +46,7 @@ pub use neighbours::{
 pub use params::{EngineParams, QueueChoice, Switch};
 pub use reference::ReferenceSimulation;
 pub use setup::{OverlapAudit, SetupError, check_box};
-pub use simulation::divided::{Divided, Lead, Side, Stop, Unordered};
+pub use simulation::divided::{Divided, Lead, Ordered, Side, Stop, Unordered};
 pub use simulation::{Simulation, SimulationState};
 pub use sources::growth::{Ending, Growth};
 pub use sources::{Event, EventCounts, EventKind, MAX_PARTICLES, Outcome};

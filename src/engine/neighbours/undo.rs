@@ -41,6 +41,13 @@ impl<const D: usize> Neighbours<D> {
         self.log.as_ref().map_or(0, Vec::len)
     }
 
+    /// Forgets the first `mark` changes recorded (they can no longer be undone).
+    pub(crate) fn forget(&mut self, mark: usize) {
+        if let Some(log) = &mut self.log {
+            log.drain(..mark);
+        }
+    }
+
     /// Records particle `k`'s rows before they change.
     #[inline]
     pub(super) fn note_rows(&mut self, k: usize) {

@@ -83,6 +83,8 @@ pub(crate) struct Region<const D: usize> {
     told: u64,
     /// What each item changed, when recording ([`journal`]).
     journal: Option<Vec<journal::Record<D>>>,
+    /// The item being taken: its owner and event, which head each batch it sends.
+    item: (u32, Event),
 }
 
 /// A slab.
@@ -124,13 +126,16 @@ enum What<const D: usize> {
     Members { chunk: [u32; CHUNK], len: u8 },
     /// Every particle was predicted again (an event counter wrapped to 0).
     Everyone,
+    /// The first change of every batch: the item that sent it, `owner`'s `event`, which
+    /// places the batch in the total order (not counted as told).
+    Item { owner: u32, event: Event },
 }
 
 /// The particles whose state a batch of changes sets.
 fn changed<const D: usize>(batch: &[Change<D>]) -> impl Iterator<Item = usize> + '_ {
     batch.iter().filter_map(|c| match c.what {
         What::Course { k, .. } | What::Neighbourhood { k, .. } => Some(k as usize),
-        What::Members { .. } | What::Everyone => None,
+        What::Members { .. } | What::Everyone | What::Item { .. } => None,
     })
 }
 
@@ -152,6 +157,7 @@ impl<const D: usize> Region<D> {
             outbox: Vec::new(),
             told: 0,
             journal: None,
+            item: (0, Event::NOTHING),
         }
     }
 
@@ -209,6 +215,10 @@ impl<const D: usize> Simulation<D> {
         let time = self.time;
         let region = self.region.as_deref_mut().expect("divided");
         region.told += 1;
+        if region.outbox.is_empty() {
+            let (owner, event) = region.item;
+            region.outbox.push(Change { time, what: What::Item { owner, event } });
+        }
         region.outbox.push(Change { time, what });
     }
 
@@ -322,7 +332,7 @@ impl<const D: usize> Simulation<D> {
                     let mine = |j: usize| region.owner[j] == region.side;
                     self.neighbours.rebuild_told(k, &self.particles[k], self.time, members, mine, joins);
                 }
-                What::Members { .. } | What::Everyone => {}
+                What::Members { .. } | What::Everyone | What::Item { .. } => {}
             }
         }
         for change in changes {
@@ -342,7 +352,7 @@ impl<const D: usize> Simulation<D> {
                         poisoned(&mut self.particles[k]);
                     }
                 }
-                What::Members { .. } => {}
+                What::Members { .. } | What::Item { .. } => {}
                 What::Everyone => self.predict_everyone(),
             }
         }
@@ -626,16 +636,30 @@ impl Watch {
     /// was (it moves cell only at a stamp of its own), so only the cells around `k`'s
     /// stamped after `t` are looked into.
     fn read_since<const D: usize>(&self, neighbours: &Neighbours<D>, k: usize, t: f64) -> bool {
-        if self.particles[k] > t {
+        self.read_from(neighbours, k, t.next_up())
+    }
+}
+
+impl Watch {
+    /// Whether `k`, or a particle whose searches read `k`, was read at or after `t`
+    /// ([`read_since`](Self::read_since), with a read at `t` itself counted).
+    fn read_from<const D: usize>(&self, neighbours: &Neighbours<D>, k: usize, t: f64) -> bool {
+        if self.particles[k] >= t {
             return true;
         }
         neighbours.cells_around(k).as_slice().iter().any(|&c| {
-            self.cells[c as usize] > t
+            self.cells[c as usize] >= t
                 && neighbours
                     .cells()
                     .members(c)
-                    .any(|i| self.particles[i as usize] > t && neighbours.searches(i as usize, k))
+                    .any(|i| self.particles[i as usize] >= t && neighbours.searches(i as usize, k))
         })
+    }
+
+    /// Takes every read later than `t` back to `t` (reads undone: still counted, as if at
+    /// `t`, which no later change comes before).
+    fn clamp(&mut self, t: f64) {
+        self.particles.iter_mut().chain(self.cells.iter_mut()).for_each(|x| *x = x.min(t));
     }
 }
 
@@ -840,5 +864,7 @@ impl<const D: usize> Divided<D> {
 
 mod journal;
 mod mailbox;
+mod ordered;
+pub use ordered::Ordered;
 #[cfg(test)]
 mod tests;

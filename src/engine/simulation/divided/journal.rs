@@ -58,6 +58,13 @@ pub(crate) struct Mark {
     neighbourhood: usize,
 }
 
+impl Mark {
+    /// This mark once the records before `forgotten` are forgotten.
+    pub(crate) fn after_forgetting(self, forgotten: Mark) -> Mark {
+        Mark { records: self.records - forgotten.records, neighbourhood: self.neighbourhood - forgotten.neighbourhood }
+    }
+}
+
 impl<const D: usize> Simulation<D> {
     /// Starts (or stops and forgets) recording what each item changes.
     pub(crate) fn record(&mut self, on: bool) {
@@ -107,6 +114,8 @@ impl<const D: usize> Simulation<D> {
     /// Takes the earliest item as [`take`](Simulation::take) does, recording first what it
     /// will change when recording.
     pub(super) fn take_noted(&mut self) -> super::super::Taken<D> {
+        let (owner, event) = self.queue.first();
+        self.region.as_deref_mut().expect("divided").item = (owner as u32, event);
         if self.recording() {
             self.note_next();
         }
@@ -147,7 +156,7 @@ impl<const D: usize> Simulation<D> {
             match change.what {
                 super::What::Course { k, .. } => self.note_particle(k as usize, false),
                 super::What::Neighbourhood { k, .. } => self.note_particle(k as usize, true),
-                super::What::Members { .. } => {}
+                super::What::Members { .. } | super::What::Item { .. } => {}
                 super::What::Everyone => self.note_everyone(),
             }
         }
@@ -184,6 +193,14 @@ impl<const D: usize> Simulation<D> {
         }
         self.neighbours.undo_to(mark.neighbourhood);
         self.region.as_deref_mut().expect("divided").journal = Some(journal);
+    }
+
+    /// Forgets the records before `mark`, which can no longer be undone: every mark given
+    /// since is moved back by as many ([`Mark::after_forgetting`]).
+    pub(crate) fn forget(&mut self, mark: Mark) {
+        let region = self.region.as_deref_mut().expect("divided");
+        region.journal.as_mut().expect("recording").drain(..mark.records);
+        self.neighbours.forget(mark.neighbourhood);
     }
 
     /// How many records this side holds (its own and its neighbourhood's).

@@ -28,7 +28,18 @@ impl<T> Batches<T> {
         starts.zip(&self.ends).map(|(from, &to)| &self.items[from..to])
     }
 
-    fn clear(&mut self) {
+    /// How many batches.
+    pub(crate) fn len(&self) -> usize {
+        self.ends.len()
+    }
+
+    /// Batch `i`.
+    pub(crate) fn get(&self, i: usize) -> &[T] {
+        let from = if i == 0 { 0 } else { self.ends[i - 1] };
+        &self.items[from..self.ends[i]]
+    }
+
+    pub(crate) fn clear(&mut self) {
         self.items.clear();
         self.ends.clear();
     }
