@@ -237,7 +237,7 @@ pub struct Ordered {
 
 impl<const D: usize> Divided<D> {
     /// Runs both sides at once, each in its own thread, until neither has an item before
-    /// `end`, keeping the order of time (see the [module](self)): afterwards the divided box
+    /// `end`, keeping the order of time (docs/engine.md, "Two threads in the order of time"): afterwards the divided box
     /// holds what the whole box holds after its items before `end`, bit for bit, and [`step`]
     /// goes on from there. `lead` holds a side back while its next item is further ahead of
     /// the other's than it allows.
