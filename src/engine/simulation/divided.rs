@@ -83,8 +83,6 @@ pub(crate) struct Region<const D: usize> {
     told: u64,
     /// What each item changed, when recording ([`journal`]).
     journal: Option<Vec<journal::Record<D>>>,
-    /// The item being taken: its owner and event, which head each batch it sends.
-    item: (u32, Event),
 }
 
 /// A slab.
@@ -126,8 +124,8 @@ enum What<const D: usize> {
     Members { chunk: [u32; CHUNK], len: u8 },
     /// Every particle was predicted again (an event counter wrapped to 0).
     Everyone,
-    /// The first change of every batch: the item that sent it, `owner`'s `event`, which
-    /// places the batch in the total order (not counted as told).
+    /// The first change of a batch of the ordered schedule's: `owner`'s `event`, the key
+    /// that places the batch in the order (`ordered`; not counted as told).
     Item { owner: u32, event: Event },
 }
 
@@ -157,7 +155,6 @@ impl<const D: usize> Region<D> {
             outbox: Vec::new(),
             told: 0,
             journal: None,
-            item: (0, Event::NOTHING),
         }
     }
 
@@ -215,10 +212,6 @@ impl<const D: usize> Simulation<D> {
         let time = self.time;
         let region = self.region.as_deref_mut().expect("divided");
         region.told += 1;
-        if region.outbox.is_empty() {
-            let (owner, event) = region.item;
-            region.outbox.push(Change { time, what: What::Item { owner, event } });
-        }
         region.outbox.push(Change { time, what });
     }
 
@@ -638,9 +631,7 @@ impl Watch {
     fn read_since<const D: usize>(&self, neighbours: &Neighbours<D>, k: usize, t: f64) -> bool {
         self.read_from(neighbours, k, t.next_up())
     }
-}
 
-impl Watch {
     /// Whether `k`, or a particle whose searches read `k`, was read at or after `t`
     /// ([`read_since`](Self::read_since), with a read at `t` itself counted).
     fn read_from<const D: usize>(&self, neighbours: &Neighbours<D>, k: usize, t: f64) -> bool {

@@ -114,8 +114,6 @@ impl<const D: usize> Simulation<D> {
     /// Takes the earliest item as [`take`](Simulation::take) does, recording first what it
     /// will change when recording.
     pub(super) fn take_noted(&mut self) -> super::super::Taken<D> {
-        let (owner, event) = self.queue.first();
-        self.region.as_deref_mut().expect("divided").item = (owner as u32, event);
         if self.recording() {
             self.note_next();
         }

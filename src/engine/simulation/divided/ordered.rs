@@ -324,10 +324,11 @@ impl<const D: usize> Simulation<D> {
             idle = 0;
             self.take_one(raw, key, &mut book);
             let region = self.region.as_deref_mut().expect("divided");
-            if let Some(header) = region.outbox.first_mut() {
-                // The batch takes its place in the order from the item's key, which may be
-                // an earlier item's (see the module).
-                header.what = What::Item { owner: key.owner, event: key.event };
+            if let Some(&Change { time, .. }) = region.outbox.first() {
+                // The batch opens with its place in the order: the item's key, which may be
+                // an earlier item's (see the module), at the item's time (the receiver's
+                // clock is the batch's first change's).
+                region.outbox.insert(0, Change { time, what: What::Item { owner: key.owner, event: key.event } });
                 out.send(&region.outbox);
                 region.outbox.clear();
                 book.sent += 1;
