@@ -48,15 +48,19 @@
 //! particle the receiver had read since (its events' particles and their neighbours) —
 //! those an engine that keeps the order has to undo its events for — how many events of
 //! its own lay between, and how many of the others put an event of the receiver's into its
-//! past.
+//! past. Last, the division in two threads that keeps the order of time
+//! ([`Divided::run_ordered`], the whole box's events to the bit, checked each run), against
+//! the whole box in three alternated rounds, free and within 4, 16 and 64 intervals, with
+//! what it undid and how often the sides met.
 //!
 //! ```text
 //! cargo bench --bench border                          # N = 10 976 and 97 556, 10⁶ events each
 //! cargo bench --bench border -- 10976 --events 2000000
+//! cargo bench --bench border -- 10976 --ordered       # the ordered runs' table alone
 //! ```
 //!
 //! With `--test` (as `cargo bench -- --test` runs every bench) it checks the schedule on
-//! cases with known answers and replays a small system.
+//! cases with known answers, replays a small system and runs the ordered table on it.
 
 use collide::engine::{Divided, Lead, Outcome, RANGE_HOLDS_3D, SimBox, Simulation, Stop};
 use nalgebra::Vector3;
@@ -534,10 +538,100 @@ fn two_threads(sim: &Simulation<3>, events: u64) {
     }
 }
 
+/// How far ahead of the other a side of the ordered runs may go, in the whole box's mean
+/// times between events (`None`: free).
+const ORDERED_LEADS: [Option<f64>; 4] = [None, Some(4.0), Some(16.0), Some(64.0)];
+
+/// The engine's own division in two threads in the order of time ([`Divided::run_ordered`]),
+/// against the whole box from the same warmed-up start: `ROUNDS` rounds alternated in this
+/// process, each the whole box's `events` events and then the ordered run to the time of the
+/// last of them, for each lead ([`ORDERED_LEADS`]). Every run is checked against the whole
+/// box (one further item taken, the counts and particles equal to the bit), then its events
+/// per second over the whole box's (median and range), and per own item what it undid,
+/// the batches that came late and conflicted, and how often the sides met.
+fn ordered(sim: &Simulation<3>, events: u64) {
+    const ROUNDS: usize = 3;
+    let (start, sim_box) = (sim.particles().to_vec(), *sim.sim_box());
+    let interval = sim.time() / sim.counts().total() as f64;
+    let mut ratios: Vec<Vec<f64>> = ORDERED_LEADS.iter().map(|_| Vec::new()).collect();
+    let mut counted: Vec<[u64; 6]> = ORDERED_LEADS.iter().map(|_| [0; 6]).collect();
+    // Collisions per second, the whole box's and each lead's ordered run's.
+    let mut whole_rates = Vec::new();
+    let mut rates: Vec<Vec<f64>> = ORDERED_LEADS.iter().map(|_| Vec::new()).collect();
+    for _ in 0..ROUNDS {
+        let mut whole = Simulation::new(start.clone(), sim_box).expect("a valid start");
+        let clock = std::time::Instant::now();
+        for _ in 0..events {
+            whole.step().expect("events go on");
+        }
+        let whole_seconds = clock.elapsed().as_secs_f64();
+        let whole_rate = events as f64 / whole_seconds;
+        // (A new simulation counts from 0.)
+        let collisions = whole.counts().pair as f64;
+        whole_rates.push(collisions / whole_seconds);
+        let end = whole.time();
+        for (((lead, ratio), counts), rate) in ORDERED_LEADS.iter().zip(&mut ratios).zip(&mut counted).zip(&mut rates) {
+            let lead = lead.map_or(Lead::Free, |w| Lead::Within(w * interval));
+            let mut divided = Divided::new(start.clone(), sim_box).expect("a valid start");
+            let clock = std::time::Instant::now();
+            let run = divided.run_ordered(end, lead);
+            let seconds = clock.elapsed().as_secs_f64();
+            divided.step().expect("events go on");
+            assert_eq!(divided.counts(), whole.counts(), "the ordered run's events differ from the whole box's");
+            let same = divided
+                .particles()
+                .iter()
+                .zip(whole.particles())
+                .all(|(a, b)| a.position == b.position && a.velocity == b.velocity && a.time == b.time);
+            assert!(same, "the ordered run's particles differ from the whole box's");
+            ratio.push(events as f64 / seconds / whole_rate);
+            rate.push(collisions / seconds);
+            for (c, x) in counts.iter_mut().zip([
+                run.items[0] + run.items[1],
+                run.undone[0] + run.undone[1],
+                run.late[0] + run.late[1],
+                run.conflicts[0] + run.conflicts[1],
+                run.rendezvous,
+                run.waits[0] + run.waits[1],
+            ]) {
+                *c += x;
+            }
+        }
+    }
+    let median = |x: &mut Vec<f64>| {
+        x.sort_by(f64::total_cmp);
+        x[x.len() / 2]
+    };
+    println!(
+        "divided, two threads in the order of time (the whole box's events to the bit): events per second over the whole box's (the whole box {:.3}·10⁶ collisions/s, median)",
+        median(&mut whole_rates) * 1e-6
+    );
+    println!(
+        "| lead | median (range) | 10⁶ collisions/s | undone per item | late batches per item | conflicts per item | meetings per item | waits per item |"
+    );
+    for (((lead, ratio), counts), rate) in ORDERED_LEADS.iter().zip(&mut ratios).zip(&counted).zip(&mut rates) {
+        let lead = lead.map_or("free".to_string(), |w| format!("{w} intervals"));
+        let middle = median(ratio);
+        let per_item = |x: u64| x as f64 / counts[0] as f64;
+        println!(
+            "| {lead} | {middle:.3} ({:.3}–{:.3}) | {:.3} | {:.4} | {:.4} | {:.5} | {:.5} | {:.4} |",
+            ratio[0],
+            ratio[ratio.len() - 1],
+            median(rate) * 1e-6,
+            per_item(counts[1]),
+            per_item(counts[2]),
+            per_item(counts[3]),
+            per_item(counts[4]),
+            per_item(counts[5]),
+        );
+    }
+}
+
 fn report(n: usize, events: u64) {
     let sim = warmed_up(n);
     divided(&sim, events);
     two_threads(&sim, events);
+    ordered(&sim, events);
     let (schedules, traffic) = replay(sim, events);
     let (range, skin) = range_and_skin();
     println!(
@@ -652,6 +746,8 @@ fn check() {
             s.kept()
         );
     }
+    // The ordered runs' table on a small box: every run checked against the whole box.
+    ordered(&warmed_up(2048), 20_000);
     println!("border: schedule checks passed");
 }
 
@@ -663,9 +759,12 @@ fn main() {
     }
     let mut sizes = Vec::new();
     let mut events = 1_000_000;
+    let mut only_ordered = false;
     let mut it = args.iter();
     while let Some(a) = it.next() {
-        if a == "--events" {
+        if a == "--ordered" {
+            only_ordered = true;
+        } else if a == "--events" {
             events = it.next().and_then(|v| v.parse().ok()).expect("--events takes a count");
         } else {
             sizes.push(a.parse::<usize>().unwrap_or_else(|_| panic!("not a particle count: {a}")));
@@ -675,6 +774,11 @@ fn main() {
         sizes = vec![10_976, 97_556];
     }
     for n in sizes {
-        report(n, events);
+        if only_ordered {
+            println!("N = {n}, η = {ETA}, {events} events after the warm-up; two slabs across x");
+            ordered(&warmed_up(n), events);
+        } else {
+            report(n, events);
+        }
     }
 }

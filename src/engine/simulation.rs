@@ -675,6 +675,12 @@ impl<const D: usize> Simulation<D> {
     #[inline(always)]
     fn take(&mut self) -> Taken<D> {
         let (owner, next) = self.queue.first();
+        self.take_first(owner, next)
+    }
+
+    /// [`take`](Self::take) with the queue's first item (`owner`'s `next`) known already.
+    #[inline(always)]
+    fn take_first(&mut self, owner: usize, next: Event) -> Taken<D> {
         let end = self.growth.map(|g| Event { time: g.predict(), kind: EventKind::GrowthEnd });
         let ends_first = end.is_some_and(|end| end.before(u32::MAX, &next, owner as u32));
         if let Some(time) = self.sampling.predict()

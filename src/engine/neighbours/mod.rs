@@ -42,7 +42,6 @@ mod undo;
 
 use crate::engine::arrays::Store;
 use crate::engine::geometry::{Boundary, Particle, SimBox};
-use crate::engine::motion;
 use cells::{Cells, Coord};
 pub use lists::{LISTS_FROM, LISTS_FROM_3D, RANGE_HOLDS, RANGE_HOLDS_3D};
 use lists::{List, NONE, Rows, skin_for};
@@ -526,8 +525,13 @@ impl<const D: usize> Neighbours<D> {
 
     /// When particle `p` (number `i`) next has to [`rebuild`](Self::rebuild), as an absolute
     /// time no earlier than `now`: following, when it leaves its cell; with lists, when it
-    /// reaches the skin's exit radius (it is inside at `now`): `now + τ`, `τ` the larger root
-    /// of `|d + vτ|² = h²`, `d = r(now) − cᵢ`, taken in the form without cancellation.
+    /// reaches the skin's exit radius (it is inside from its own time `tₚ` on, until it
+    /// rebuilds): `max(tₚ + τ, now)`, `τ` the larger root of `|d + vτ|² = h²`,
+    /// `d = r(tₚ) − cᵢ`, taken in the form without cancellation. Measured from the
+    /// particle's own time, not `now`, the time depends on `now` only through that floor:
+    /// a re-prediction whose result is no earlier than some clock gives the same bits from
+    /// any earlier clock, which the ordered two-thread schedule relies on (docs/engine.md,
+    /// "Two threads in the order of time").
     /// Velocities are scaled first by the power of two that brings their largest component
     /// into `[1, 2)` (or as near as the exponent range allows), so that neither `|v|²` nor
     /// `d·v` overflows or underflows; a power of two, so that scaling and unscaling are exact
@@ -552,15 +556,18 @@ impl<const D: usize> Neighbours<D> {
         let inverse = f64::from_bits(((2046 - biased) as u64) << 52);
         let (mut a, mut b, mut dd) = (0.0, 0.0, 0.0);
         for k in 0..D {
-            let d = motion::coordinate(p.position[k], p.velocity[k], now - p.time) - c[k];
+            let d = p.position[k] - c[k];
             let u = p.velocity[k] * inverse;
             a += u * u;
             b += d * u;
             dd += d * d;
         }
-        // Inside (up to rounding, at the instant of leaving): the constant term is ≤ 0.
-        let c0 = (dd - self.exit2).min(0.0);
-        let root = (b * b - a * c0).sqrt();
+        // Inside at `tₚ` but for rounding at the instant of leaving (the constant term ≤ 0),
+        // or, when `tₚ` is before the last rebuild, perhaps outside and bound to come in:
+        // then the constant term is positive and the line meets the sphere, but for
+        // rounding when it grazes (the discriminant held at 0).
+        let c0 = dd - self.exit2;
+        let root = (b * b - a * c0).max(0.0).sqrt();
         // The larger root without cancellation, in whichever form the sign of `b` allows.
         // Moving toward or away from the centre is a coin toss for the branch predictor, and
         // a miss here would stall behind the square root: both forms are selected, then
@@ -569,7 +576,7 @@ impl<const D: usize> Neighbours<D> {
         let numerator = std::hint::select_unpredictable(toward, root - b, -c0);
         let denominator = std::hint::select_unpredictable(toward, a, b + root);
         let tau = numerator / denominator * inverse;
-        let t = now + tau.max(0.0);
+        let t = (p.time + tau.max(0.0)).max(now);
         t.is_finite().then_some(t)
     }
 
@@ -753,7 +760,8 @@ mod tests {
 
     /// The exit time puts the particle on the exit radius — early by no more than rounding,
     /// and never outside half the skin — for speeds over the whole exponent range (tiny,
-    /// subnormal, huge) and for directions toward and away from the centre. The exit
+    /// subnormal, huge), for directions toward and away from the centre, and from an own
+    /// time before the clock at which the particle was still outside, coming in. The exit
     /// radius sits 2³² ulps inside half the skin, and one rounding's worth either way is
     /// about 10⁻¹⁵ of it. (Any scale cancels out exactly; what can go wrong is a scale that
     /// leaves the exponent range — 0 or ∞ past the largest binade, checked by breaking the
@@ -787,7 +795,7 @@ mod tests {
         assert!(neighbours.listed());
         let (exit, bound) = (neighbours.exit2.sqrt(), neighbours.bound2.sqrt());
         let mut rng = Xoshiro256PlusPlus::seed_from_u64(5);
-        let mut checked = 0;
+        let (mut checked, mut earlier) = (0, 0);
         for exponent in (-1074..=1023).step_by(7).chain([-1074, -1023, -1022, 1022, 1023]) {
             for _ in 0..20 {
                 let i = rng.random_range(0..particles.len());
@@ -801,9 +809,15 @@ mod tests {
                 }
                 let offset = rng.random_range(0.0..0.9) * exit;
                 let at = rng.random_range(0.0..std::f64::consts::TAU);
+                // One time in three the particle's own time is well before the clock (0),
+                // where it was outside the exit radius (as when it rebuilt since it last
+                // changed course): 1 to 3 exit radii back along its path.
+                let back = rng.random_range(1.0..3.0) * exit / speed;
+                let back = if rng.random_bool(1.0 / 3.0) && back.is_finite() { back } else { 0.0 };
                 let p = Particle {
-                    position: neighbours.centres[i] + SVector::from([at.cos(), at.sin()]) * offset,
+                    position: neighbours.centres[i] + SVector::from([at.cos(), at.sin()]) * offset - velocity * back,
                     velocity,
+                    time: -back,
                     ..particles[i].clone()
                 };
                 let Some(t) = neighbours.exit_time(i, &p, 0.0) else {
@@ -812,12 +826,14 @@ mod tests {
                     continue;
                 };
                 let d = (p.position_at(t) - neighbours.centres[i]).norm();
+                assert!(t >= 0.0, "before the clock at speed {speed:e}: {t}");
                 assert!(d <= bound, "outside the skin at speed {speed:e}: {d} > {bound}");
-                assert!(d >= exit * (1.0 - 1e-12), "early at speed {speed:e}: {d} < {exit}");
+                assert!(d >= exit * (1.0 - 1e-12), "early at speed {speed:e} ({back:e} back): {d} < {exit}");
                 checked += 1;
+                earlier += usize::from(back > 0.0);
             }
         }
-        assert!(checked > 2500, "{checked}");
+        assert!(checked > 2500 && earlier > 500, "{checked}, {earlier} from an earlier own time");
     }
 
     /// Lists stay what they are defined to be through thousands of rebuilds of spheres that

@@ -60,6 +60,7 @@ use crate::engine::neighbours::Neighbours;
 use crate::engine::params::EngineParams;
 use crate::engine::setup::SetupError;
 use crate::engine::sources::{Event, EventCounts, Outcome};
+use nalgebra::SVector;
 
 /// One side's view of the division: its slab, every particle's side and what it has still
 /// to tell the other side.
@@ -101,22 +102,47 @@ impl Side {
     }
 }
 
+/// What an event can change of a particle's record: where it is, its velocity, its own
+/// time and its event counter. Its radius, mass and species never change in a divided box
+/// (which does not grow), and every side holds them from the start: a change or an undo
+/// record carries these alone, a third of a sphere's padded record.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub(crate) struct Moved<const D: usize> {
+    position: SVector<f64, D>,
+    velocity: SVector<f64, D>,
+    time: f64,
+    events: u32,
+}
+
+impl<const D: usize> Moved<D> {
+    fn of(p: &Particle<D>) -> Self {
+        Moved { position: p.position, velocity: p.velocity, time: p.time, events: p.events }
+    }
+
+    fn set(&self, p: &mut Particle<D>) {
+        p.position = self.position;
+        p.velocity = self.velocity;
+        p.time = self.time;
+        p.events = self.events;
+    }
+}
+
 /// What one side tells the other after an event of its own.
-#[derive(Clone, Debug)]
+#[derive(Clone, Copy, Debug)]
 pub(crate) struct Change<const D: usize> {
     /// The event's time.
     time: f64,
     what: What<D>,
 }
 
-#[derive(Clone, Debug)]
+#[derive(Clone, Copy, Debug)]
 enum What<const D: usize> {
     /// Particle `k` changed course: its new state; predicted again skipping `skip` (itself:
     /// skipping none).
-    Course { k: u32, state: Particle<D>, skip: u32 },
+    Course { k: u32, state: Moved<D>, skip: u32 },
     /// Particle `k`'s neighbourhood was updated (its list built again around it, or it
     /// moved to the next cell); its state, which the other side may not have.
-    Neighbourhood { k: u32, state: Particle<D> },
+    Neighbourhood { k: u32, state: Moved<D> },
     /// With lists, after a `Neighbourhood` change: up to [`CHUNK`] more of the particles
     /// within range of its particle's new centre (its list as the rebuild found it), which
     /// the receiver takes instead of scanning its replica, whose centres far from the
@@ -220,7 +246,7 @@ impl<const D: usize> Simulation<D> {
     fn tell_course(&mut self, k: usize, skip: usize) {
         let region = self.region.as_deref().expect("divided");
         if region.owner[k] != region.side || region.near(k) {
-            self.tell(What::Course { k: k as u32, state: self.particles[k].clone(), skip: skip as u32 });
+            self.tell(What::Course { k: k as u32, state: Moved::of(&self.particles[k]), skip: skip as u32 });
         }
     }
 
@@ -260,7 +286,7 @@ impl<const D: usize> Simulation<D> {
                 // The grid moves a particle one cell from where the replica has it: every move
                 // is told. A list is centred where the particle is: only near ones are.
                 if was_near || near || !self.neighbours.listed() {
-                    self.tell(What::Neighbourhood { k: i as u32, state: self.particles[i].clone() });
+                    self.tell(What::Neighbourhood { k: i as u32, state: Moved::of(&self.particles[i]) });
                     self.tell_members();
                 }
                 if side == self.region.as_deref().expect("divided").side {
@@ -308,10 +334,10 @@ impl<const D: usize> Simulation<D> {
         self.time = first.time;
         for (at, change) in changes.iter().enumerate() {
             match change.what {
-                What::Course { k, ref state, .. } => self.particles[k as usize] = state.clone(),
+                What::Course { k, ref state, .. } => state.set(&mut self.particles[k as usize]),
                 What::Neighbourhood { k, ref state } => {
                     let k = k as usize;
-                    self.particles[k] = state.clone();
+                    state.set(&mut self.particles[k]);
                     // With lists, the members the rebuild found follow the update.
                     let members = changes[at + 1..].iter().map_while(|c| match c.what {
                         What::Members { ref chunk, len } => Some(&chunk[..len as usize]),
@@ -395,7 +421,7 @@ impl<const D: usize> Simulation<D> {
                     continue;
                 }
             }
-            match self.take_noted() {
+            match self.take_noted(owner as usize, item) {
                 Taken::Event(outcome) => {
                     run.events += 1;
                     chain = if watch.history.last() == Some(&self.time) { chain + 1 } else { 1 };
@@ -711,7 +737,7 @@ impl<const D: usize> Divided<D> {
                 ([a, b], [ea, eb])
             };
             let s = first_b.before(b, &first_a, a) as usize;
-            let taken = self.sides[s].take_noted();
+            let taken = self.sides[s].take_noted([a, b][s] as usize, [first_a, first_b][s]);
             let region = self.sides[s].region.as_deref_mut().expect("divided");
             std::mem::swap(&mut self.mail, &mut region.outbox);
             self.sides[1 - s].receive(&self.mail);

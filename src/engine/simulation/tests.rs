@@ -313,3 +313,50 @@ fn lookahead_changes_nothing_for_spheres() {
     assert_eq!(plain.time().to_bits(), ahead.time().to_bits());
     assert_eq!(plain.counts(), ahead.counts());
 }
+
+/// A prediction depends on the clock only as a floor under its candidates' times: predicted
+/// again from any later clock no later than what it found, a particle gets the same event,
+/// bit for bit — the property the ordered two-thread schedule relies on when a change
+/// arrives that would have moved the clock of a re-prediction marker already taken
+/// (docs/engine.md, "Two threads in the order of time"). Spheres with lists and disks with
+/// the grid, every particle, three later clocks each; rebuilds and pairs among the events
+/// found, and a clock past the event does change some (the floor is real).
+#[test]
+fn predictions_do_not_depend_on_an_earlier_clock() {
+    fn check<const D: usize>(mut sim: Simulation<D>, steps: usize) {
+        for _ in 0..steps {
+            sim.step();
+        }
+        let (mut rebuilds, mut pairs, mut floored) = (0, 0, 0);
+        for i in 0..sim.particles.len() {
+            let mut first = sim.clone();
+            first.predict(i);
+            let found = first.queue.get(i);
+            rebuilds += usize::from(found.kind == EventKind::Rebuild);
+            pairs += usize::from(matches!(found.kind, EventKind::Pair { .. }));
+            for share in [0.25, 0.75, 1.0] {
+                let mut later = sim.clone();
+                later.time = sim.time + share * (found.time - sim.time);
+                later.predict(i);
+                let again = later.queue.get(i);
+                assert_eq!(
+                    (again.time.to_bits(), again.kind),
+                    (found.time.to_bits(), found.kind),
+                    "particle {i} from the clock {} and {}",
+                    sim.time,
+                    later.time
+                );
+            }
+            let mut past = sim.clone();
+            past.time = found.time + 0.5 * (found.time - sim.time);
+            past.predict(i);
+            floored += usize::from(past.queue.get(i) != found);
+        }
+        let n = sim.particles.len();
+        assert!(rebuilds > n / 50 && pairs > n / 2, "{rebuilds} rebuilds and {pairs} pairs of {n}");
+        assert!(floored > n / 2, "a clock past the event changed only {floored} of {n}");
+    }
+    let (particles, sim_box) = crate::bench::state::initial_state::<3>(2048, 0.45, 3).expect("a state");
+    check(Simulation::with_neighbourhood(particles, sim_box, Neighbourhood::Lists).expect("a simulation"), 30_000);
+    check(system(40, false, Neighbourhood::Grid), 20_000);
+}

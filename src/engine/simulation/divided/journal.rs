@@ -32,8 +32,7 @@
 #![cfg_attr(not(test), allow(dead_code))]
 
 use super::super::Simulation;
-use super::Side;
-use crate::engine::geometry::Particle;
+use super::{Moved, Side};
 use crate::engine::sources::{Event, EventCounts, EventKind};
 
 /// One thing as it was before an item changed it.
@@ -41,8 +40,8 @@ use crate::engine::sources::{Event, EventCounts, EventKind};
 pub(crate) enum Record<const D: usize> {
     /// The start of an item: the clock, the counts, and the changes told so far.
     Item { time: f64, counts: EventCounts, told: u64 },
-    /// Particle `k`'s state.
-    State { k: u32, state: Particle<D> },
+    /// Particle `k`'s state (what an event can change of it).
+    State { k: u32, state: Moved<D> },
     /// Particle `k`'s pending event.
     Pending { k: u32, event: Event },
     /// Particle `k`'s anchor.
@@ -97,7 +96,7 @@ impl<const D: usize> Simulation<D> {
 
     /// Records particle `k`'s state and pending event, and with `anchor` its anchor.
     fn note_particle(&mut self, k: usize, anchor: bool) {
-        self.note(Record::State { k: k as u32, state: self.particles[k].clone() });
+        self.note(Record::State { k: k as u32, state: Moved::of(&self.particles[k]) });
         self.note(Record::Pending { k: k as u32, event: self.queue.get(k) });
         if anchor {
             let x = self.region.as_deref().expect("divided").anchor[k];
@@ -111,18 +110,17 @@ impl<const D: usize> Simulation<D> {
         self.note(Record::Everyone(pending));
     }
 
-    /// Takes the earliest item as [`take`](Simulation::take) does, recording first what it
-    /// will change when recording.
-    pub(super) fn take_noted(&mut self) -> super::super::Taken<D> {
+    /// Takes the earliest item, `owner`'s `next` (the queue's first), as
+    /// [`take`](Simulation::take) does, recording first what it will change when recording.
+    pub(super) fn take_noted(&mut self, owner: usize, next: Event) -> super::super::Taken<D> {
         if self.recording() {
-            self.note_next();
+            self.note_next(owner, next);
         }
-        self.take()
+        self.take_first(owner, next)
     }
 
-    /// Records what the earliest item will change.
-    fn note_next(&mut self) {
-        let (owner, next) = self.queue.first();
+    /// Records what the earliest item, `owner`'s `next`, will change.
+    fn note_next(&mut self, owner: usize, next: Event) {
         self.note_item();
         if next.kind == EventKind::Nothing {
             return;
@@ -172,7 +170,7 @@ impl<const D: usize> Simulation<D> {
                     self.counts = counts;
                     self.region.as_deref_mut().expect("divided").told = told;
                 }
-                Record::State { k, state } => self.particles[k as usize] = state,
+                Record::State { k, state } => state.set(&mut self.particles[k as usize]),
                 Record::Pending { k, event } => self.queue.set(k as usize, event),
                 Record::Anchor { k, x } => {
                     // As it was, not wrapped again: an anchor can be `L₀` itself (a position

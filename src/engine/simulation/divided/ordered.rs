@@ -25,8 +25,14 @@
 //! * no particle it changes was read at or after its time (by an item of this side, a
 //!   prediction, or an earlier batch), before or after its rows are changed
 //!   ([`Watch::read_from`]);
-//! * no re-prediction marker taken since predicted from a clock earlier than its time
-//!   (a marker predicts from the clock of the last event, which the batch would have moved);
+//! * no re-prediction marker taken since found an event earlier than its time. A marker
+//!   predicts its owner from the clock of the last event, which the batch would have moved
+//!   on, but the clock enters a prediction only as a floor under every candidate's time
+//!   (pairs are solved from the later of the two particles' own times, walls and the skin's
+//!   exit from the particle's own,
+//!   [`exit_time`](crate::engine::neighbours::Neighbours::exit_time); a pair's image is
+//!   taken at the clock, the same at any clock for neighbours nearer than half the box): a
+//!   result no earlier than the batch's time is the same from either clock, bit for bit;
 //! * none of this side's particles it predicts again comes due before the side's last item;
 //! * it does not predict every particle again (an event counter wrapped).
 //!
@@ -54,11 +60,11 @@ use super::super::{Simulation, Taken};
 use super::journal::Mark;
 use super::{Change, Divided, Lead, Watch, What, changed, mailbox};
 use crate::engine::sources::{Event, EventKind};
+use std::sync::Mutex;
 use std::sync::atomic::{AtomicBool, AtomicU64, Ordering, fence};
-use std::sync::{Barrier, Mutex};
 
 /// A side asks for a rendezvous once it holds this many items and batches to undo.
-const MOST_STEPS: usize = 4096;
+const MOST_STEPS: usize = 1024;
 
 /// A place in the total order: `owner`'s `event` on `side` (0 the lower). The two sides'
 /// copies of one collision across the border have the same event and owner pair: the
@@ -90,7 +96,7 @@ impl Key {
 }
 
 /// What a side shows the other: its next item, the batches it has sent and applied.
-#[derive(Clone, Copy, Debug)]
+#[derive(Clone, Copy, Debug, PartialEq)]
 struct Shown {
     key: Key,
     sent: u64,
@@ -145,6 +151,33 @@ impl Shop {
     }
 }
 
+/// Where the two threads wait for each other in a rendezvous: each arrival counted, and
+/// each thread spinning (then yielding) until the other has arrived as often. A meeting
+/// then costs a few hand-overs of one cache line rather than a sleep and a wake-up through
+/// the kernel, as a lock and condition variable would.
+#[repr(align(128))]
+#[derive(Default)]
+struct Meeting {
+    arrived: AtomicU64,
+}
+
+impl Meeting {
+    fn wait(&self) {
+        let mine = self.arrived.fetch_add(1, Ordering::AcqRel) + 1;
+        // Both threads arrive once a meeting: the meeting is over at the next even count.
+        let over = mine.next_multiple_of(2);
+        let mut turns = 0u32;
+        while self.arrived.load(Ordering::Acquire) < over {
+            turns += 1;
+            if turns.is_multiple_of(64) {
+                std::thread::yield_now();
+            } else {
+                std::hint::spin_loop();
+            }
+        }
+    }
+}
+
 /// What the two threads share besides their batches.
 struct Shared {
     shops: [Shop; 2],
@@ -152,7 +185,7 @@ struct Shared {
     want: AtomicBool,
     /// The earliest conflict posted since the last rendezvous.
     cut: Mutex<Option<Key>>,
-    barrier: Barrier,
+    barrier: Meeting,
     end: f64,
     lead: Lead,
 }
@@ -177,8 +210,8 @@ struct Step {
 
 #[derive(Clone, Copy, Debug)]
 enum StepWhat {
-    /// An item of this side's; `Some(clock)` for a marker (predicted from `clock`); whether
-    /// it sent a batch.
+    /// An item of this side's; for a marker, `Some` of the time its owner's prediction
+    /// found; whether it sent a batch.
     Own { marker: Option<f64>, sent: bool },
     /// A batch of the other side's, kept in `inputs[from..to]` to be applied again.
     Input { from: usize, to: usize },
@@ -196,9 +229,25 @@ struct Book<const D: usize> {
     watch: Watch,
     /// The last item of this side's taken.
     last: Option<Key>,
+    /// This side's next keys ([`next_keys`](Simulation::next_keys)), until it changes.
+    next: Option<(Key, Key)>,
+    /// What this side last showed: written again only when it changes, so that a side
+    /// that waits does not take the line from the other at every turn.
+    shown: Option<Shown>,
     sent: u64,
     applied: u64,
     run: SideOrdered,
+}
+
+impl<const D: usize> Book<D> {
+    /// Shows `key` as this side's next item, with its counts, unless that is shown already.
+    fn show(&mut self, shop: &Shop, key: Key) {
+        let shown = Shown { key, sent: self.sent, applied: self.applied };
+        if self.shown != Some(shown) {
+            shop.show(shown);
+            self.shown = Some(shown);
+        }
+    }
 }
 
 /// What one side of [`Divided::run_ordered`] counted.
@@ -248,7 +297,7 @@ impl<const D: usize> Divided<D> {
             shops: [Shop::default(), Shop::default()],
             want: AtomicBool::new(false),
             cut: Mutex::new(None),
-            barrier: Barrier::new(2),
+            barrier: Meeting::default(),
             end,
             lead,
         };
@@ -292,6 +341,8 @@ impl<const D: usize> Simulation<D> {
             cursor: 0,
             watch: Watch::new(self.particles.len(), self.neighbours.cell_count()),
             last: None,
+            next: None,
+            shown: None,
             sent: 0,
             applied: 0,
             run: SideOrdered::default(),
@@ -309,8 +360,8 @@ impl<const D: usize> Simulation<D> {
                 shared.post(cut);
                 continue;
             }
-            let (raw, key) = self.next_keys(&book);
-            shared.shops[me].show(Shown { key, sent: book.sent, applied: book.applied });
+            let (raw, key) = self.next_keys(&mut book);
+            book.show(&shared.shops[me], key);
             if !self.may_take(&raw, &key, &book, shared) {
                 book.run.waits += u64::from(idle == 0);
                 idle += 1;
@@ -372,18 +423,24 @@ impl<const D: usize> Simulation<D> {
 
     /// The next item's own key and the key that places it in the order: the later of its
     /// own and the last item's (see the module).
-    fn next_keys(&mut self, book: &Book<D>) -> (Key, Key) {
+    /// Kept until the side changes: a side that waits would otherwise search its queue at
+    /// every turn (and a calendar queue rebuilds itself after so many searches).
+    fn next_keys(&mut self, book: &mut Book<D>) -> (Key, Key) {
+        if let Some(keys) = book.next {
+            return keys;
+        }
         let (owner, event) = self.earliest();
         let raw = Key { event, owner, side: book.side };
-        (raw, book.last.filter(|last| raw.before(last)).unwrap_or(raw))
+        let keys = (raw, book.last.filter(|last| raw.before(last)).unwrap_or(raw));
+        book.next = Some(keys);
+        keys
     }
 
     /// Takes the next item (`key`), recording it.
     fn take_one(&mut self, raw: Key, key: Key, book: &mut Book<D>) {
         let marker = raw.event.kind != EventKind::Nothing && !raw.event.is_live(&self.particles);
-        let clock = self.time;
         let mark = self.mark();
-        match self.take_noted() {
+        match self.take_noted(raw.owner as usize, raw.event) {
             Taken::Event(outcome) => {
                 let (a, b) = match outcome {
                     crate::engine::sources::Outcome::Pair { i, j, .. } => (i, j),
@@ -398,8 +455,10 @@ impl<const D: usize> Simulation<D> {
             Taken::End => unreachable!("an item before the end"),
         }
         book.run.items += 1;
-        book.steps.push(Step { key, mark, what: StepWhat::Own { marker: marker.then_some(clock), sent: false } });
+        let found = marker.then(|| self.queue.get(raw.owner as usize).time);
+        book.steps.push(Step { key, mark, what: StepWhat::Own { marker: found, sent: false } });
         book.last = Some(key);
+        book.next = None;
     }
 
     /// Applies the batches that come before this side's next item, taking them from
@@ -414,11 +473,11 @@ impl<const D: usize> Simulation<D> {
                     return None;
                 }
             }
-            let batch = book.pending.get(book.cursor);
-            let key = Key::of_batch(batch, 1 - book.side);
+            let key = Key::of_batch(book.pending.get(book.cursor), 1 - book.side);
             if !key.before(&self.next_keys(book).1) {
                 return None;
             }
+            let batch = book.pending.get(book.cursor);
             book.cursor += 1;
             let from = book.inputs.len();
             book.inputs.extend_from_slice(batch);
@@ -446,6 +505,7 @@ impl<const D: usize> Simulation<D> {
         let mark = self.mark();
         let clock = self.time;
         self.receive(batch);
+        book.next = None;
         if late {
             self.time = clock;
             let last = book.last.expect("late");
@@ -464,14 +524,15 @@ impl<const D: usize> Simulation<D> {
         conflict.then_some(key)
     }
 
-    /// Whether a marker taken after `key` predicted from a clock earlier than its time.
+    /// Whether a marker taken after `key` found an event earlier than its time (see the
+    /// module).
     fn marker_since(steps: &[Step], key: &Key) -> bool {
         for step in steps.iter().rev() {
             if let StepWhat::Own { marker, .. } = step.what {
                 if !key.before(&step.key) {
                     return false;
                 }
-                if marker.is_some_and(|clock| clock < key.time()) {
+                if marker.is_some_and(|found| found < key.time()) {
                     return true;
                 }
             }
@@ -499,7 +560,7 @@ impl<const D: usize> Simulation<D> {
             book.pending.clear();
         }
         let key = self.next_keys(book).1;
-        shared.shops[me].show(Shown { key, sent: book.sent, applied: book.applied });
+        book.show(&shared.shops[me], key);
         shared.barrier.wait();
         let theirs = shared.shops[1 - me].read();
         let floor = if key.before(&theirs.key) { key } else { theirs.key };
@@ -532,6 +593,7 @@ impl<const D: usize> Simulation<D> {
             }
         }
         book.last = book.steps.iter().rev().find(|s| matches!(s.what, StepWhat::Own { .. })).map(|s| s.key);
+        book.next = None;
         book.watch.clamp(cut.time());
         for step in undone {
             if let StepWhat::Input { from, to } = step.what
