@@ -73,6 +73,11 @@ impl<T: Clone> Mailbox<T> {
         self.any.store(true, Ordering::Release);
     }
 
+    /// Whether a batch is waiting to be taken.
+    pub(crate) fn waiting(&self) -> bool {
+        self.any.load(Ordering::Acquire)
+    }
+
     /// Takes every batch sent so far into `into` (emptied first); false if there was none.
     pub(crate) fn take(&self, into: &mut Batches<T>) -> bool {
         into.clear();

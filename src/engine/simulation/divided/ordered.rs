@@ -43,10 +43,14 @@
 //! there. Nothing before the earliest conflict is undone, and the batch that conflicted is
 //! applied in its place, so every rendezvous moves the committed point forward.
 //!
-//! Two things keep conflicts rare without deciding anything: a collision with a particle
-//! of the other side waits until the other side's next item comes after it (the other
-//! side's copy of the same collision would otherwise be resolved as well, and undone), and
-//! a side waits while its next item is more than the [`Lead`] ahead of the other's.
+//! Two things keep conflicts rare without deciding anything. A collision across the border
+//! is in both sides' queues, and the lower side's copy comes first in the order: the upper
+//! side holds its copy back until the lower side's next item comes after it and the
+//! batches sent before are taken (the lower copy's batch makes the upper copy a marker;
+//! taken first, it would be resolved twice, and undone), while the lower side takes its
+//! copy at once (undone in the rare case that an earlier item of the upper side's changes
+//! either particle). And a side waits while its next item is more than the [`Lead`] ahead
+//! of the other's.
 //!
 //! # Rendezvous
 //!
@@ -362,7 +366,7 @@ impl<const D: usize> Simulation<D> {
             }
             let (raw, key) = self.next_keys(&mut book);
             book.show(&shared.shops[me], key);
-            if !self.may_take(&raw, &key, &book, shared) {
+            if !self.may_take(&raw, &key, &book, shared, inbox) {
                 book.run.waits += u64::from(idle == 0);
                 idle += 1;
                 if idle % 64 == 0 {
@@ -400,7 +404,14 @@ impl<const D: usize> Simulation<D> {
     /// lead, and, for a collision with the other side's particle, before the other side's
     /// next item. At the end, asks for the last rendezvous once both sides are there and
     /// every batch has been applied.
-    fn may_take(&self, raw: &Key, key: &Key, book: &Book<D>, shared: &Shared) -> bool {
+    fn may_take(
+        &self,
+        raw: &Key,
+        key: &Key,
+        book: &Book<D>,
+        shared: &Shared,
+        inbox: &mailbox::Mailbox<Change<D>>,
+    ) -> bool {
         let other = || shared.shops[1 - book.side as usize].read();
         if key.time() >= shared.end {
             let theirs = other();
@@ -418,7 +429,15 @@ impl<const D: usize> Simulation<D> {
         {
             return false;
         }
-        !across || key.before(&other().key)
+        // The lower side's copy of a collision across the border comes first: the upper side
+        // waits until the lower side's next item follows it, and then until every batch
+        // sent before that item was shown is taken (the lower copy's among them, which
+        // makes this copy a marker): a batch held back as not yet due comes after this
+        // item, and so does everything sent after it. The lower side goes on, and undoes
+        // its copy should an earlier item of the other side's turn out to change either
+        // particle.
+        let taken = || book.cursor < book.pending.len() || !inbox.waiting();
+        !across || book.side == 0 || (key.before(&other().key) && taken())
     }
 
     /// The next item's own key and the key that places it in the order: the later of its
