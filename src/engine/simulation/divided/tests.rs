@@ -269,7 +269,7 @@ fn ordered_matches<const D: usize>(
     events: u64,
     lead: Lead,
 ) -> Ordered {
-    let (mut whole, mut divided) = whole_and_divided(particles, sim_box, neighbourhood);
+    let (mut whole, divided) = whole_and_divided(particles, sim_box, neighbourhood);
     let mut probe = whole.clone();
     for _ in 0..events {
         probe.step();
@@ -278,13 +278,24 @@ fn ordered_matches<const D: usize>(
     while whole.queue.first().1.time < end {
         whole.take();
     }
-    let run = divided.run_ordered(end, lead);
+    // In a thread of its own, watched: a schedule that loses track of its batches never
+    // ends, and the test should fail, not hang (the run takes well under a second).
+    let (done, finished) = std::sync::mpsc::channel();
+    std::thread::spawn(move || {
+        let mut divided = divided;
+        let run = divided.run_ordered(end, lead);
+        done.send((divided, run)).expect("the test waits");
+    });
+    let (divided, run) = finished
+        .recv_timeout(std::time::Duration::from_secs(60))
+        .expect("the ordered run did not end within a minute: sent and applied batches never met");
     assert_eq!(whole.counts(), divided.counts(), "{run:?}");
     let particles = divided.particles();
     for (k, p) in whole.particles.iter().enumerate() {
         assert_eq!(*p, particles[k], "particle {k} after {run:?}");
     }
     assert!(divided.replicas_agree(), "{run:?}");
+    let mut divided = divided;
     for k in 0..5000 {
         assert_eq!(whole.step(), divided.step(), "event {k} after the ordered run");
     }
