@@ -105,7 +105,7 @@ impl Side {
 /// What an event can change of a particle's record: where it is, its velocity, its own
 /// time and its event counter. Its radius, mass and species never change in a divided box
 /// (which does not grow), and every side holds them from the start: a change or an undo
-/// record carries these alone, a third of a sphere's padded record.
+/// record carries these alone, half of a sphere's padded record.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub(crate) struct Moved<const D: usize> {
     position: SVector<f64, D>,

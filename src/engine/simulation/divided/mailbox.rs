@@ -81,7 +81,7 @@ impl<T: Clone> Mailbox<T> {
     /// Takes every batch sent so far into `into` (emptied first); false if there was none.
     pub(crate) fn take(&self, into: &mut Batches<T>) -> bool {
         into.clear();
-        if !self.any.load(Ordering::Acquire) {
+        if !self.waiting() {
             return false;
         }
         let mut waiting = self.waiting.lock().unwrap_or_else(|e| e.into_inner());

@@ -401,8 +401,8 @@ impl<const D: usize> Simulation<D> {
     }
 
     /// Whether this side may take its next item (`key`) now: before the end, within the
-    /// lead, and, for a collision with the other side's particle, before the other side's
-    /// next item. At the end, asks for the last rendezvous once both sides are there and
+    /// lead, and, for the upper side's copy of a collision across the border, once the
+    /// lower side's copy is taken and its batch applied. At the end, asks for the last rendezvous once both sides are there and
     /// every batch has been applied.
     fn may_take(
         &self,
@@ -442,6 +442,7 @@ impl<const D: usize> Simulation<D> {
 
     /// The next item's own key and the key that places it in the order: the later of its
     /// own and the last item's (see the module).
+    ///
     /// Kept until the side changes: a side that waits would otherwise search its queue at
     /// every turn (and a calendar queue rebuilds itself after so many searches).
     fn next_keys(&mut self, book: &mut Book<D>) -> (Key, Key) {
