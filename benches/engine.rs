@@ -12,14 +12,17 @@
 //! `engine/parts` times pieces of one collision's work at N = 10⁴, η = 0.65, to show where
 //! the time goes: `bracket_pair` over every pair of a warmed-up state closer than 1.8σ (per
 //! pair); `bracket_neighbours`, the batch version the engine runs, over every particle's
-//! cell neighbours (per particle, i.e. per prediction); and replacing the earliest event of
+//! cell neighbours (per particle, i.e. per prediction); a search's short last chunk, each
+//! particle's first four neighbours, bracketed at the full width and at half of it
+//! (`chunk_of_four`, per particle); and replacing the earliest event of
 //! a queue of 10⁴ by a later one, with either structure (per update, as after every
 //! collision; in the tree the root owner's is the longest walk).
 
 use collide::bench::floor::Floor;
 use collide::engine::init::{Placement, Species, Velocities, box_for_packing_fraction, initial_particles};
 use collide::engine::internals::{
-    EventQueue, LANES, Lanes, PairBracket, QueueKind, bracket_neighbours, bracket_pair, pair_positions,
+    EventQueue, HALF, LANES, Lanes, PairBracket, QueueKind, bracket_half, bracket_neighbours, bracket_pair,
+    pair_positions,
 };
 use collide::engine::{Boundary, Radii, Simulation};
 use collide::engine::{Event, EventKind};
@@ -170,6 +173,30 @@ fn parts(c: &mut Criterion) {
             n
         })
     });
+    // A search's short last chunk: each particle's first HALF neighbours, at the full width
+    // and at half of it (what the engine does where vectors hold four f64).
+    for (name, half) in [("chunk_of_four/full_width", false), ("chunk_of_four/half_width", true)] {
+        group.bench_function(name, |b| {
+            b.iter(|| {
+                let mut n = 0.0;
+                for (i, js) in near.iter().enumerate() {
+                    let len = js.len().min(HALF);
+                    let (mut lo, mut hi) = ([0.0; LANES], [0.0; LANES]);
+                    let mut full = [i as u32; LANES];
+                    full[..len].copy_from_slice(&js[..len]);
+                    let mut lanes = Lanes::default();
+                    let m = if half {
+                        let quarter = full[..HALF].try_into().expect("HALF wide");
+                        bracket_half(ps, i, quarter, len, sim_box, black_box(now), &mut lo, &mut hi, &mut lanes)
+                    } else {
+                        bracket_neighbours(ps, i, &full, len, sim_box, black_box(now), &mut lo, &mut hi, &mut lanes)
+                    };
+                    n += m;
+                }
+                n
+            })
+        });
+    }
     // A queue of 10⁴ events; each update moves the earliest one later by a pseudo-random step.
     let wall = |time| Event { time, kind: EventKind::Wall { axis: 0, upper: true } };
     let mut rng = Xoshiro256PlusPlus::seed_from_u64(3);

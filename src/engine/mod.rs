@@ -57,7 +57,7 @@ pub use sources::{Event, EventCounts, EventKind, MAX_PARTICLES, Outcome};
 #[doc(hidden)]
 pub mod internals {
     pub use super::queue::{EventQueue, QueueKind};
-    pub use super::search::{LANES, Lanes, bracket_neighbours};
+    pub use super::search::{HALF, LANES, Lanes, bracket_half, bracket_neighbours};
     pub use super::sources::pair::{PairBracket, bracket as bracket_pair, positions as pair_positions};
     pub use super::timing::huge_page_bytes;
 

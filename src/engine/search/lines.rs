@@ -43,11 +43,11 @@ pub(super) fn first_lines<const D: usize>(records: &[&Particle<D>; RECORDS]) -> 
     }
 }
 
-/// [`first_lines`], one field at a time (the fields past the radius are left at zero).
-#[cfg_attr(all(target_arch = "x86_64", target_feature = "avx512f"), allow(dead_code))]
+/// [`first_lines`], one field at a time, for any number of records `W` (the fields past the
+/// radius are left at zero).
 #[inline(always)]
-fn first_lines_by_field<const D: usize>(records: &[&Particle<D>; RECORDS]) -> [[f64; RECORDS]; 8] {
-    let mut out = [[0.0; RECORDS]; 8];
+pub(super) fn first_lines_by_field<const D: usize, const W: usize>(records: &[&Particle<D>; W]) -> [[f64; W]; 8] {
+    let mut out = [[0.0; W]; 8];
     for (k, q) in records.iter().enumerate() {
         for a in 0..D {
             out[a][k] = q.position[a];

@@ -22,6 +22,12 @@
 //! built in ([`lines`]): a chunk is bound by the vector operations it issues, and the
 //! field-by-field gather was a hundred of them.
 //!
+//! Where a vector register holds four f64 rather than eight (AVX2), a chunk of eight is two
+//! vectors per value, and a sphere's chunk spills registers; a search's last chunk, when its
+//! neighbours fit in four lanes (a sphere has about twelve neighbours in its list: a full
+//! chunk and a short one), is bracketed at half the width ([`bracket_half`]) — the same
+//! brackets bit for bit (tested), half the vector operations.
+//!
 //! Short periodic axes (several images of one pair) and crowds of more than [`NEAR`]
 //! neighbours take the scalar search, one pair at a time with a shrinking horizon; same
 //! events.
@@ -37,6 +43,14 @@ use quadratic::{BallLanes, contact_brackets_from_origin, contact_time_unchecked,
 
 /// Pairs bracketed at once: one AVX-512 register of f64 (two AVX2).
 pub const LANES: usize = 8;
+
+/// The lanes of [`bracket_half`], for a chunk whose neighbours fit in half of it.
+pub const HALF: usize = LANES / 2;
+
+/// Whether a short chunk is bracketed at half the width ([`bracket_half`]): where a vector
+/// register holds fewer than [`LANES`] f64 (AVX2: four), the half-width kernel issues half
+/// the vector operations; with AVX-512 one register holds the whole chunk either way.
+const HALF_PAYS: bool = !cfg!(target_feature = "avx512f");
 
 /// Neighbours gathered per prediction for the batch search (more: the scalar search).
 pub(crate) const NEAR: usize = 64;
@@ -89,10 +103,14 @@ impl<const D: usize> Side<D> {
         start: usize,
     ) -> f64 {
         let chunk = start..start + LANES;
-        let js = near[chunk.clone()].try_into().expect("LANES wide");
-        let (lo, hi) = (&mut self.lo[chunk.clone()], &mut self.hi[chunk]);
+        let (lo, hi) = (&mut self.lo[chunk.clone()], &mut self.hi[chunk.clone()]);
         let (lo, hi) = (lo.try_into().expect("LANES wide"), hi.try_into().expect("LANES wide"));
         let balls = &mut self.lanes[start / LANES];
+        if HALF_PAYS && n_near - start <= HALF {
+            let js = near[start..start + HALF].try_into().expect("HALF wide");
+            return bracket_half(particles, i, js, n_near - start, sim_box, now, lo, hi, balls);
+        }
+        let js = near[chunk.clone()].try_into().expect("LANES wide");
         bracket_neighbours(particles, i, js, n_near - start, sim_box, now, lo, hi, balls)
     }
 
@@ -373,25 +391,93 @@ pub fn bracket_neighbours<const D: usize>(
     hi: &mut [f64; LANES],
     lanes: &mut Lanes<D>,
 ) -> f64 {
-    let p = &particles[i];
+    let fields = lines::first_lines(&records(particles, i, js, len));
+    let Lanes { first, second, t0 } = lanes;
+    bracket_fields(&particles[i], &fields, len, sim_box, now, lo, hi, first, second, t0)
+}
+
+/// [`bracket_neighbours`] for a chunk whose neighbours fit in its first [`HALF`] lanes
+/// (`len ≤ HALF`), at half the width: the same brackets in lanes `..HALF` and the same
+/// smallest upper end, bit for bit (each lane is computed alone, and the lanes past the
+/// neighbours give `[+∞, +∞]` either way); lanes `HALF..` get `[+∞, +∞]`, and their balls
+/// are left as they were (no candidate is ever taken from them). Where the vector
+/// registers hold fewer f64 than a chunk (AVX2: four), this issues half the vector
+/// operations — and a search's last chunk is often this short.
+#[inline]
+#[allow(clippy::too_many_arguments)]
+pub fn bracket_half<const D: usize>(
+    particles: &[Particle<D>],
+    i: usize,
+    js: &[u32; HALF],
+    len: usize,
+    sim_box: &SimBox<D>,
+    now: f64,
+    lo: &mut [f64; LANES],
+    hi: &mut [f64; LANES],
+    lanes: &mut Lanes<D>,
+) -> f64 {
+    let fields = lines::first_lines_by_field(&records(particles, i, js, len));
+    let (mut first, mut second, mut t0) =
+        (BallLanes::<D, HALF>::default(), BallLanes::<D, HALF>::default(), [0.0; HALF]);
+    let (mut l, mut h) = ([0.0; HALF], [0.0; HALF]);
+    let m = bracket_fields(&particles[i], &fields, len, sim_box, now, &mut l, &mut h, &mut first, &mut second, &mut t0);
+    lo[..HALF].copy_from_slice(&l);
+    hi[..HALF].copy_from_slice(&h);
+    lo[HALF..].fill(f64::INFINITY);
+    hi[HALF..].fill(f64::INFINITY);
+    // The balls, for the candidates' exact times; the first ball's positions stay at the
+    // origin in both.
+    for a in 0..D {
+        lanes.first.velocity[a][..HALF].copy_from_slice(&first.velocity[a]);
+        lanes.second.position[a][..HALF].copy_from_slice(&second.position[a]);
+        lanes.second.velocity[a][..HALF].copy_from_slice(&second.velocity[a]);
+    }
+    lanes.first.radius[..HALF].copy_from_slice(&first.radius);
+    lanes.second.radius[..HALF].copy_from_slice(&second.radius);
+    lanes.t0[..HALF].copy_from_slice(&t0);
+    m
+}
+
+/// The neighbours' records, one lane each (unused lanes pair `i` with itself).
+#[inline(always)]
+fn records<'a, const D: usize, const W: usize>(
+    particles: &'a [Particle<D>],
+    i: usize,
+    js: &[u32; W],
+    len: usize,
+) -> [&'a Particle<D>; W] {
     let last = particles.len() - 1;
-    // Gather: the neighbours' states, one lane each (unused lanes pair `i` with itself).
-    let records: [&Particle<D>; LANES] =
-        core::array::from_fn(|k| &particles[std::hint::select_unpredictable(k < len, js[k] as usize, i).min(last)]);
-    let fields = lines::first_lines(&records);
-    let qx: [[f64; LANES]; D] = core::array::from_fn(|a| fields[a]);
-    let qv: [[f64; LANES]; D] = core::array::from_fn(|a| fields[D + a]);
+    core::array::from_fn(|k| &particles[std::hint::select_unpredictable(k < len, js[k] as usize, i).min(last)])
+}
+
+/// The body of [`bracket_neighbours`] and [`bracket_half`], `W` lanes wide, from the
+/// neighbours' fields (`fields[f][k]`, as [`lines::first_lines`] lays them out).
+#[inline(always)]
+#[allow(clippy::too_many_arguments)]
+fn bracket_fields<const D: usize, const W: usize>(
+    p: &Particle<D>,
+    fields: &[[f64; W]; 8],
+    len: usize,
+    sim_box: &SimBox<D>,
+    now: f64,
+    lo: &mut [f64; W],
+    hi: &mut [f64; W],
+    first: &mut BallLanes<D, W>,
+    second: &mut BallLanes<D, W>,
+    t0: &mut [f64; W],
+) -> f64 {
+    let qx: [[f64; W]; D] = core::array::from_fn(|a| fields[a]);
+    let qv: [[f64; W]; D] = core::array::from_fn(|a| fields[D + a]);
     let (qt, qr) = (fields[2 * D], fields[2 * D + 1]);
     // The balls, as `pair::predict` forms them: `i` at the origin (the same for every lane)
     // and the neighbour at its separation at `t0`, the later update time, from `i` to the
     // image nearest to `i` at `now`.
-    let Lanes { first, second, t0 } = lanes;
-    let mut separation = [[0.0; LANES]; D];
-    let mut apart = [[0.0; LANES]; D];
+    let mut separation = [[0.0; W]; D];
+    let mut apart = [[0.0; W]; D];
     // Whether every lane's count was decided by comparisons, reduced in registers (a flag
     // array stored lane by lane and read back as one vector stalls on store forwarding).
     let mut decided = true;
-    for k in 0..LANES {
+    for k in 0..W {
         let t = larger(p.time, qt[k]);
         t0[k] = t;
         for a in 0..D {
@@ -416,7 +502,7 @@ pub fn bracket_neighbours<const D: usize>(
     if !decided {
         for a in 0..D {
             if sim_box.boundary[a] == Boundary::Periodic {
-                for k in 0..LANES {
+                for k in 0..W {
                     let count = image_count(separation[a][k], sim_box.lengths[a]);
                     second.position[a][k] = apart[a][k] + count * sim_box.lengths[a];
                 }
@@ -428,16 +514,16 @@ pub fn bracket_neighbours<const D: usize>(
     // computed in every lane, which compile to vector compares and blends (a branch on
     // `k < len` per lane mispredicts in the last chunk, whose length varies).
     let len = len as f64;
-    for k in 0..LANES {
+    for k in 0..W {
         let floor = if (k as f64) < len { now } else { f64::INFINITY };
         lo[k] = larger(t0[k] + lo[k], floor);
         hi[k] = larger(t0[k] + hi[k], floor);
     }
     // Pairwise, while the ends are still in registers (a fold over the stored array is a
     // serial chain of minima behind store-to-load forwarding).
-    const { assert!(LANES.is_power_of_two()) };
+    const { assert!(W.is_power_of_two()) };
     let mut m = *hi;
-    let mut width = LANES;
+    let mut width = W;
     while width > 1 {
         width /= 2;
         for k in 0..width {
@@ -505,5 +591,61 @@ impl<const D: usize> Lanes<D> {
         let narrowed = narrow_contact(&self.first.get(k), &self.second.get(k), guess)?;
         let (a, b) = ((t0 + narrowed.lo()).max(now), (t0 + narrowed.hi()).max(now));
         if a == b { Some(a) } else { narrowed.time().map(|t| (t0 + t).max(now)) }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::engine::Simulation;
+
+    /// A chunk of at most [`HALF`] neighbours gives the same brackets, smallest upper end and
+    /// balls at half the width as at the full width, bit for bit — every lane of `lo` and
+    /// `hi`, and the balls of the lanes that hold a neighbour (the only ones a candidate is
+    /// taken from). The states are a run's, so that the particles' own times differ and
+    /// some pairs are seen through the periodic boundary; every particle is tried against
+    /// every count of the next particles in its list order, 1 to `HALF`.
+    fn half_chunks_match<const D: usize>(n: usize, eta: f64) {
+        let (particles, sim_box) = crate::bench::state::initial_state::<D>(n, eta, 11).expect("a state");
+        let mut sim = Simulation::new(particles, sim_box).expect("a simulation");
+        for _ in 0..20 * n {
+            sim.step().expect("an event");
+        }
+        let (ps, sim_box, now) = (sim.particles(), sim.sim_box(), sim.time());
+        let mut tried = 0;
+        for i in 0..ps.len() {
+            for len in 1..=HALF {
+                // The `len` particles after `i` in index order, and some far across the box.
+                let js: [u32; HALF] = core::array::from_fn(|k| ((i + 1 + k * (1 + i % 7)) % ps.len()) as u32);
+                let mut full = [i as u32; LANES];
+                full[..HALF].copy_from_slice(&js);
+                let (mut lo, mut hi, mut lanes) = ([0.0; LANES], [0.0; LANES], Lanes::default());
+                let m = bracket_neighbours(ps, i, &full, len, sim_box, now, &mut lo, &mut hi, &mut lanes);
+                let (mut lo2, mut hi2, mut lanes2) = ([1.0; LANES], [1.0; LANES], Lanes::default());
+                let m2 = bracket_half(ps, i, &js, len, sim_box, now, &mut lo2, &mut hi2, &mut lanes2);
+                assert_eq!(m.to_bits(), m2.to_bits(), "particle {i}, {len} neighbours");
+                for k in 0..LANES {
+                    assert_eq!((lo[k].to_bits(), hi[k].to_bits()), (lo2[k].to_bits(), hi2[k].to_bits()), "lane {k}");
+                }
+                for k in 0..len {
+                    assert_eq!(lanes.first.get(k), lanes2.first.get(k), "lane {k}");
+                    assert_eq!(lanes.second.get(k), lanes2.second.get(k), "lane {k}");
+                    assert_eq!(lanes.t0[k].to_bits(), lanes2.t0[k].to_bits(), "lane {k}");
+                }
+                tried += lo[..len].iter().filter(|&&l| l < f64::INFINITY).count();
+            }
+        }
+        // Enough lanes bracket a contact that a wrong one would show.
+        assert!(tried > n, "{tried} contacts bracketed");
+    }
+
+    #[test]
+    fn half_chunks_bracket_as_full_ones_for_disks() {
+        half_chunks_match::<2>(400, 0.6);
+    }
+
+    #[test]
+    fn half_chunks_bracket_as_full_ones_for_spheres() {
+        half_chunks_match::<3>(500, 0.45);
     }
 }
