@@ -186,8 +186,8 @@ fn parts(c: &mut Criterion) {
                     full[..len].copy_from_slice(&js[..len]);
                     let mut lanes = Lanes::default();
                     let m = if half {
-                        let quarter = full[..HALF].try_into().expect("HALF wide");
-                        bracket_half(ps, i, quarter, len, sim_box, black_box(now), &mut lo, &mut hi, &mut lanes)
+                        let short = full[..HALF].try_into().expect("HALF wide");
+                        bracket_half(ps, i, short, len, sim_box, black_box(now), &mut lo, &mut hi, &mut lanes)
                     } else {
                         bracket_neighbours(ps, i, &full, len, sim_box, black_box(now), &mut lo, &mut hi, &mut lanes)
                     };

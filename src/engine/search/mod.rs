@@ -419,12 +419,11 @@ pub fn bracket_half<const D: usize>(
     let fields = lines::first_lines_by_field(&records(particles, i, js, len));
     let (mut first, mut second, mut t0) =
         (BallLanes::<D, HALF>::default(), BallLanes::<D, HALF>::default(), [0.0; HALF]);
-    let (mut l, mut h) = ([0.0; HALF], [0.0; HALF]);
-    let m = bracket_fields(&particles[i], &fields, len, sim_box, now, &mut l, &mut h, &mut first, &mut second, &mut t0);
-    lo[..HALF].copy_from_slice(&l);
-    hi[..HALF].copy_from_slice(&h);
-    lo[HALF..].fill(f64::INFINITY);
-    hi[HALF..].fill(f64::INFINITY);
+    let (l, lo_rest) = lo.split_first_chunk_mut::<HALF>().expect("HALF within LANES");
+    let (h, hi_rest) = hi.split_first_chunk_mut::<HALF>().expect("HALF within LANES");
+    let m = bracket_fields(&particles[i], &fields, len, sim_box, now, l, h, &mut first, &mut second, &mut t0);
+    lo_rest.fill(f64::INFINITY);
+    hi_rest.fill(f64::INFINITY);
     // The balls, for the candidates' exact times; the first ball's positions stay at the
     // origin in both.
     for a in 0..D {
