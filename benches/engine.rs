@@ -24,9 +24,10 @@ use collide::engine::internals::{
     EventQueue, HALF, LANES, Lanes, PairBracket, QueueKind, bracket_half, bracket_neighbours, bracket_pair,
     pair_positions,
 };
-use collide::engine::{Boundary, Radii, Simulation};
+use collide::engine::{Boundary, Particle, Radii, SimBox, Simulation};
 use collide::engine::{Event, EventKind};
-use criterion::{BenchmarkId, Criterion, Throughput, criterion_group, criterion_main};
+use criterion::measurement::WallTime;
+use criterion::{BenchmarkGroup, BenchmarkId, Criterion, Throughput, criterion_group, criterion_main};
 use rand::rngs::Xoshiro256PlusPlus;
 use rand::{RngExt, SeedableRng};
 use std::hint::black_box;
@@ -173,30 +174,21 @@ fn parts(c: &mut Criterion) {
             n
         })
     });
-    // A search's short last chunk: each particle's first HALF neighbours, at the full width
-    // and at half of it (what the engine does where vectors hold four f64).
-    for (name, half) in [("chunk_of_four/full_width", false), ("chunk_of_four/half_width", true)] {
-        group.bench_function(name, |b| {
-            b.iter(|| {
-                let mut n = 0.0;
-                for (i, js) in near.iter().enumerate() {
-                    let len = js.len().min(HALF);
-                    let (mut lo, mut hi) = ([0.0; LANES], [0.0; LANES]);
-                    let mut full = [i as u32; LANES];
-                    full[..len].copy_from_slice(&js[..len]);
-                    let mut lanes = Lanes::default();
-                    let m = if half {
-                        let short = full[..HALF].try_into().expect("HALF wide");
-                        bracket_half(ps, i, short, len, sim_box, black_box(now), &mut lo, &mut hi, &mut lanes)
-                    } else {
-                        bracket_neighbours(ps, i, &full, len, sim_box, black_box(now), &mut lo, &mut hi, &mut lanes)
-                    };
-                    n += m;
-                }
-                n
-            })
-        });
+    chunks_of_four(&mut group, ps, sim_box, now, &near, "");
+    let spheres = warmed_up_3d(4000, 0.45);
+    let (ps, sim_box, now) = (spheres.particles(), spheres.sim_box(), spheres.time());
+    let mut near: Vec<Vec<u32>> = vec![Vec::new(); ps.len()];
+    for i in 0..ps.len() {
+        for j in i + 1..ps.len() {
+            let (a, b) = pair_positions(&ps[i], &ps[j], sim_box, now);
+            // About the twelve neighbours of a sphere's list at η = 0.45.
+            if (b - a).norm() < 1.55 {
+                near[i].push(j as u32);
+                near[j].push(i as u32);
+            }
+        }
     }
+    chunks_of_four(&mut group, ps, sim_box, now, &near, "3d/");
     // A queue of 10⁴ events; each update moves the earliest one later by a pseudo-random step.
     let wall = |time| Event { time, kind: EventKind::Wall { axis: 0, upper: true } };
     let mut rng = Xoshiro256PlusPlus::seed_from_u64(3);
@@ -214,6 +206,73 @@ fn parts(c: &mut Criterion) {
         });
     }
     group.finish();
+}
+
+/// A search's short last chunk: each particle's first HALF neighbours, at the full width
+/// and at half of it (what the engine does where vectors hold four f64) — unscreened
+/// (bound +∞), and screened against the smallest upper end over all the particle's
+/// neighbours (the bound a search has reached by its last chunk, or below it).
+fn chunks_of_four<const D: usize>(
+    group: &mut BenchmarkGroup<'_, WallTime>,
+    ps: &[Particle<D>],
+    sim_box: &SimBox<D>,
+    now: f64,
+    near: &[Vec<u32>],
+    prefix: &str,
+) {
+    let reached: Vec<f64> = near
+        .iter()
+        .enumerate()
+        .map(|(i, js)| {
+            let mut bound = f64::INFINITY;
+            for chunk in js.chunks(LANES) {
+                let (mut lo, mut hi) = ([0.0; LANES], [0.0; LANES]);
+                let mut full = [i as u32; LANES];
+                full[..chunk.len()].copy_from_slice(chunk);
+                let m = bracket_neighbours(
+                    ps,
+                    i,
+                    &full,
+                    chunk.len(),
+                    sim_box,
+                    now,
+                    &mut lo,
+                    &mut hi,
+                    &mut Lanes::default(),
+                );
+                bound = bound.min(m);
+            }
+            bound
+        })
+        .collect();
+    let unbounded = vec![f64::INFINITY; ps.len()];
+    for (name, half, bounds) in [
+        ("chunk_of_four/full_width", false, &unbounded),
+        ("chunk_of_four/half_width", true, &unbounded),
+        ("chunk_of_four/half_width_screened", true, &reached),
+    ] {
+        group.bench_function(format!("{prefix}{name}"), |b| {
+            b.iter(|| {
+                let mut n = 0.0;
+                for (i, js) in near.iter().enumerate() {
+                    let len = js.len().min(HALF);
+                    let (mut lo, mut hi) = ([0.0; LANES], [0.0; LANES]);
+                    let mut full = [i as u32; LANES];
+                    full[..len].copy_from_slice(&js[..len]);
+                    let mut lanes = Lanes::default();
+                    let m = if half {
+                        let short = full[..HALF].try_into().expect("HALF wide");
+                        let bound = black_box(bounds[i]);
+                        bracket_half(ps, i, short, len, sim_box, black_box(now), bound, &mut lo, &mut hi, &mut lanes)
+                    } else {
+                        bracket_neighbours(ps, i, &full, len, sim_box, black_box(now), &mut lo, &mut hi, &mut lanes)
+                    };
+                    n += m;
+                }
+                n
+            })
+        });
+    }
 }
 
 fn config() -> Criterion {

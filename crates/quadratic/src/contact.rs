@@ -432,6 +432,78 @@ pub fn contact_brackets_from_origin<const D: usize, const L: usize>(
     brackets::<D, L, true>(first, second, lo, hi)
 }
 
+/// Which of `L` pairs, every first ball at the origin (as [`contact_brackets_from_origin`]
+/// takes them), certainly do not touch before `horizon[k]`: `true` in lane `k` means that
+/// [`contact_time_unchecked`] gives `Never`, or `At(t)` with the exact time of the inputs
+/// later than `horizon[k]` (so `t ≥ horizon[k]` after rounding) — for a `horizon[k] ≥ 0`. A
+/// cheaper verdict than a bracket, for the lanes an engine has no use for: those receding and
+/// those whose contact falls after an event it already holds. `false` claims nothing.
+///
+/// Branch-free, like the brackets: `true` when the inputs are in the filter's range (as
+/// [`contact_brackets`] checks it) and either
+///
+/// - the pair certainly recedes, `b̃ > β` (the brackets' own test: they give `[+∞, +∞]`), or
+/// - `(c̃ − γ)(1 − 8u) > 2H·(β − b̃) + 2⁻¹⁰²²`, [`contact_time_within`]'s test: with `b̃` and
+///   `c̃` within `β` and `γ` of the exact `b` and `c`, it makes `c > 2H·max(−b, 0)`, so the
+///   gap `F(t) = c + 2bt + |Δv|²t² ≥ c + 2bt` stays open on `[0, H]` — the pair recedes,
+///   misses, or meets at a smaller root `c/(−b + √D) ≥ c/(−2b) > H`.
+///
+/// The second test is the tangent at the start, which pairs far from contact undershoot
+/// (below, lane 0 at `H = 1.5`); NaN and infinite inputs fail the range check, and an
+/// overflowing right side (a NaN or +∞) fails the comparison.
+///
+/// ```
+/// use quadratic::{contact_clear_until_from_origin, BallLanes, Ball};
+/// let mut first = BallLanes::<3, 4>::default();
+/// let mut second = BallLanes::<3, 4>::default();
+/// for k in 0..4 {
+///     first.set(k, &Ball { position: [0.0; 3], velocity: [1.0, 0.0, 0.0], radius: 0.5 });
+/// }
+/// let at = |x: f64, v: f64| Ball { position: [x, 0.0, 0.0], velocity: [v, 0.0, 0.0], radius: 0.5 };
+/// second.set(0, &at(5.0, -1.0)); // meets at t = 2
+/// second.set(1, &at(5.0, -1.0)); // meets at t = 2
+/// second.set(2, &at(5.0, 2.0)); // recedes
+/// second.set(3, &at(0.5, -1.0)); // overlaps, approaching: now
+/// let clear = contact_clear_until_from_origin(&first, &second, &[1.0, 2.5, 1e9, 1.0]);
+/// assert_eq!(clear, [true, false, true, false]);
+/// let clear = contact_clear_until_from_origin(&first, &second, &[1.5, 2.0, 1e9, 0.0]);
+/// assert_eq!(clear, [false, false, true, false]); // 1.5: the tangent meets at 1.2
+/// ```
+#[inline(always)]
+pub fn contact_clear_until_from_origin<const D: usize, const L: usize>(
+    first: &BallLanes<D, L>,
+    second: &BallLanes<D, L>,
+    horizon: &[f64; L],
+) -> [bool; L] {
+    const HI: f64 = pow2(150);
+    const LO: f64 = pow2(-150);
+    // A loop over the lanes (as in the brackets), not `array::from_fn`, whose closure the
+    // compiler keeps out of line and scalar.
+    let mut clear = [false; L];
+    for k in 0..L {
+        let (r1, r2) = (first.radius[k], second.radius[k]);
+        let s = r1 + r2;
+        let h: [f64; D] = core::array::from_fn(|i| second.position[i][k]);
+        let g: [f64; D] = core::array::from_fn(|i| second.velocity[i][k] - first.velocity[i][k]);
+        let (b, _, bound_b) = filter_b(&h, &g);
+        let (c, _, bound_c) = filter_c(&h, s);
+        // The range of `in_range`, whose NaN screen (through `q` and the discriminant's
+        // scale) is here the comparisons': a NaN in `h` makes `c̃` NaN, one in `g` makes
+        // `b̃` NaN, and both tests then fail.
+        let (mut lmax, mut vmax) = (s, 0.0f64);
+        for i in 0..D {
+            let (ah, ag) = (h[i].abs(), g[i].abs());
+            lmax = if ah > lmax { ah } else { lmax };
+            vmax = if ag > vmax { ag } else { vmax };
+        }
+        let ok = r1 >= 0.0 && r2 >= 0.0 && (LO..=HI).contains(&lmax) && (LO..=HI).contains(&vmax);
+        let big_h = horizon[k];
+        let open_until = (c - bound_c) * (1.0 - 8.0 * U) > big_h * (2.0 * (bound_b - b)) + f64::MIN_POSITIVE;
+        clear[k] = ok & (big_h >= 0.0) & ((b > bound_b) | open_until);
+    }
+    clear
+}
+
 /// [`contact_brackets`], or with `ORIGIN` [`contact_brackets_from_origin`].
 #[inline(always)]
 fn brackets<const D: usize, const L: usize, const ORIGIN: bool>(

@@ -18,7 +18,9 @@
 //!   double-double root. [`contact_brackets`] does the same for a batch of pairs held in
 //!   [`BallLanes`] (structure of arrays), branch-free, so that the pairs share vector registers;
 //!   [`contact_brackets_from_origin`] the same, bit for bit, when every first ball sits at the
-//!   origin (an engine's frame of the particle it predicts), with a few operations less a lane.
+//!   origin (an engine's frame of the particle it predicts), with a few operations less a lane;
+//!   [`contact_clear_until_from_origin`] screens such a batch for the lanes certainly clear of
+//!   a horizon (receding, or meeting later), so that a search can skip a chunk of them.
 //! * [`narrow_contact`] pins a contact time to two adjacent doubles from a guess (one
 //!   compensated, certified evaluation of the gap function), and [`Narrowed::time`] tells
 //!   which — for a caller that needs `t₀ + t` exactly when a bracket leaves two candidates.
@@ -61,7 +63,8 @@ pub mod textbook;
 pub use contact::contact_time_exact_path;
 pub use contact::{
     Ball, BallLanes, Bracket, Contact, ContactError, Field, Miss, Narrowed, contact_bracket, contact_brackets,
-    contact_brackets_from_origin, contact_time, contact_time_unchecked, contact_time_within, narrow_contact,
+    contact_brackets_from_origin, contact_clear_until_from_origin, contact_time, contact_time_unchecked,
+    contact_time_within, narrow_contact,
 };
 #[doc(hidden)]
 pub use growing::contact_time_growing_exact_path;

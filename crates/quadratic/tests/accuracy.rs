@@ -358,6 +358,74 @@ fn contact_time_within_drops_only_later_contacts_3d() {
     within_contract(contact_families_3d());
 }
 
+/// `contact_clear_until_from_origin` may clear a lane only when its pair never touches or
+/// its exact contact time is later than the horizon: every lane of a batch is checked against
+/// the exact oracle of its own pair (the second ball moved to the first's frame, as the
+/// engine forms it), at horizons at, one ulp either side of, and well before and after the
+/// contact time (and at 0, −1, ±∞). On dense-fluid hits the tangent test clears nearly every
+/// horizon of 0.49·t (it is at least half the time), so the check is not vacuous.
+fn clear_until_contract<const D: usize>(families: Vec<(&'static str, BoxedStrategy<(Ball<D>, Ball<D>)>)>) {
+    use common::families::nudge;
+    for (name, strategy) in families {
+        let (hits, cleared_early) = (RefCell::new(0usize), RefCell::new(0usize));
+        let result = runner(CASES / 4).run(&strategy, |(p, q)| {
+            // Lane 0 the pair, lane 1 swapped, lanes 2.. copies: the frame of the first ball.
+            let (mut first, mut second) = (BallLanes::<D, 4>::default(), BallLanes::<D, 4>::default());
+            let mut pairs = Vec::new();
+            for lane in 0..4 {
+                let (x, y) = if lane % 2 == 0 { (&p, &q) } else { (&q, &p) };
+                let origin = Ball { position: [0.0; D], ..*x };
+                let moved = Ball { position: core::array::from_fn(|i| y.position[i] - x.position[i]), ..*y };
+                // The first positions are never read (NaN here).
+                first.set(lane, &Ball { position: [f64::NAN; D], ..*x });
+                second.set(lane, &moved);
+                pairs.push((origin, moved));
+            }
+            let (origin, moved) = pairs[0];
+            let t = quadratic::contact_time(&origin, &moved).expect("valid inputs").time().unwrap_or(1.0);
+            let horizons =
+                [t, nudge(t, -1), nudge(t, 1), 0.49 * t, 2.0 * t, 0.0, -1.0, f64::INFINITY, f64::NEG_INFINITY];
+            for (k, &h) in horizons.iter().enumerate() {
+                let clear = quadratic::contact_clear_until_from_origin(&first, &second, &[h; 4]);
+                for (lane, (x, y)) in pairs.iter().enumerate() {
+                    if !clear[lane] {
+                        continue;
+                    }
+                    let got = quadratic::contact_time(x, y).expect("valid inputs");
+                    let later = match got {
+                        Contact::At(_) => exact_contact(x, y).exceeds(h),
+                        Contact::Now => false,
+                        Contact::Never(_) => true,
+                    };
+                    prop_assert!(later, "{:?} {:?}: cleared until {:e} but {:?}", x, y, h, got);
+                }
+                if k == 3 && matches!(quadratic::contact_time(&origin, &moved), Ok(Contact::At(_))) {
+                    *hits.borrow_mut() += 1;
+                    *cleared_early.borrow_mut() += clear[0] as usize;
+                }
+            }
+            Ok(())
+        });
+        if let Err(e) = result {
+            panic!("family '{name}': {e}");
+        }
+        if name.contains("dense-fluid") {
+            let (h, c) = (hits.into_inner(), cleared_early.into_inner());
+            assert!(h > 100 && c as f64 >= 0.95 * h as f64, "{name}: only {c} of {h} hits cleared at 0.49·t");
+        }
+    }
+}
+
+#[test]
+fn clear_until_drops_only_later_contacts_2d() {
+    clear_until_contract(contact_families());
+}
+
+#[test]
+fn clear_until_drops_only_later_contacts_3d() {
+    clear_until_contract(contact_families_3d());
+}
+
 /// The oracle itself must be able to fail: answers moved by 2 ulps, or misclassified,
 /// are caught.
 #[test]
