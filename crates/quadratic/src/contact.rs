@@ -475,28 +475,18 @@ pub fn contact_clear_until_from_origin<const D: usize, const L: usize>(
     second: &BallLanes<D, L>,
     horizon: &[f64; L],
 ) -> [bool; L] {
-    const HI: f64 = pow2(150);
-    const LO: f64 = pow2(-150);
     // A loop over the lanes (as in the brackets), not `array::from_fn`, whose closure the
     // compiler keeps out of line and scalar.
     let mut clear = [false; L];
     for k in 0..L {
         let (r1, r2) = (first.radius[k], second.radius[k]);
-        let s = r1 + r2;
         let h: [f64; D] = core::array::from_fn(|i| second.position[i][k]);
         let g: [f64; D] = core::array::from_fn(|i| second.velocity[i][k] - first.velocity[i][k]);
         let (b, _, bound_b) = filter_b(&h, &g);
-        let (c, _, bound_c) = filter_c(&h, s);
-        // The range of `in_range`, whose NaN screen (through `q` and the discriminant's
-        // scale) is here the comparisons': a NaN in `h` makes `c̃` NaN, one in `g` makes
-        // `b̃` NaN, and both tests then fail.
-        let (mut lmax, mut vmax) = (s, 0.0f64);
-        for i in 0..D {
-            let (ah, ag) = (h[i].abs(), g[i].abs());
-            lmax = if ah > lmax { ah } else { lmax };
-            vmax = if ag > vmax { ag } else { vmax };
-        }
-        let ok = r1 >= 0.0 && r2 >= 0.0 && (LO..=HI).contains(&lmax) && (LO..=HI).contains(&vmax);
+        let (c, _, bound_c) = filter_c(&h, r1 + r2);
+        // The brackets' range check; its NaN screen is here the comparisons': a NaN in `h`
+        // makes `c̃` NaN, one in `g` makes `b̃` NaN, and both tests then fail.
+        let ok = magnitudes_in_range(r1, r2, &h, &g);
         let big_h = horizon[k];
         let open_until = (c - bound_c) * (1.0 - 8.0 * U) > big_h * (2.0 * (bound_b - b)) + f64::MIN_POSITIVE;
         clear[k] = ok & (big_h >= 0.0) & ((b > bound_b) | open_until);
@@ -1072,6 +1062,16 @@ fn filtered<const D: usize, const BRACKET: bool>(first: &Ball<D>, second: &Ball<
 /// test per axis; the same verdict for every input (tested against that form).
 #[inline(always)]
 fn in_range<const D: usize>(r1: f64, r2: f64, h: &[f64; D], g: &[f64; D], q: f64, scale: f64) -> bool {
+    #[allow(clippy::eq_op)]
+    let numbers = q == q && scale == scale;
+    magnitudes_in_range(r1, r2, h, g) && numbers
+}
+
+/// [`in_range`] but its NaN screen: radii `≥ 0`, and the two maxima (`max(s, |hᵢ|)` and
+/// `max |gᵢ|`) within `2^±150`. A NaN among the `hᵢ` or `gᵢ` passes here; each caller
+/// rejects it through a value it computes anyway.
+#[inline(always)]
+fn magnitudes_in_range<const D: usize>(r1: f64, r2: f64, h: &[f64; D], g: &[f64; D]) -> bool {
     const HI: f64 = pow2(150);
     const LO: f64 = pow2(-150);
     let (mut lmax, mut vmax) = (r1 + r2, 0.0f64);
@@ -1080,9 +1080,7 @@ fn in_range<const D: usize>(r1: f64, r2: f64, h: &[f64; D], g: &[f64; D], q: f64
         lmax = if ah > lmax { ah } else { lmax };
         vmax = if ag > vmax { ag } else { vmax };
     }
-    #[allow(clippy::eq_op)]
-    let numbers = q == q && scale == scale;
-    r1 >= 0.0 && r2 >= 0.0 && lmax <= HI && lmax >= LO && vmax <= HI && vmax >= LO && numbers
+    r1 >= 0.0 && r2 >= 0.0 && (LO..=HI).contains(&lmax) && (LO..=HI).contains(&vmax)
 }
 
 /// `b̃ = ⟨g|h⟩` (FMA chain), `P = Σ|hᵢgᵢ|` and the bound `β` on `|b − b̃|` (see [`filtered`]).

@@ -650,6 +650,17 @@ mod tests {
     use super::*;
     use crate::engine::Simulation;
 
+    /// The benchmark's start for `n` particles at `eta`, after 20 collisions a particle: the
+    /// particles' own times differ, and some pairs are seen through the periodic boundary.
+    fn run_state<const D: usize>(n: usize, eta: f64, seed: u64) -> Simulation<D> {
+        let (particles, sim_box) = crate::bench::state::initial_state::<D>(n, eta, seed).expect("a state");
+        let mut sim = Simulation::new(particles, sim_box).expect("a simulation");
+        for _ in 0..20 * n {
+            sim.step().expect("an event");
+        }
+        sim
+    }
+
     /// A chunk of at most [`HALF`] neighbours gives the same brackets, smallest upper end and
     /// balls at half the width as at the full width, bit for bit — every lane of `lo` and
     /// `hi`, and the balls of the lanes that hold a neighbour (the only ones a candidate is
@@ -658,11 +669,7 @@ mod tests {
     /// every count of the next particles in its list order, 1 to `HALF`. Unscreened (an
     /// infinite bound; the screened chunk is `screened_chunks_skip_only_later_pairs`).
     fn half_chunks_match<const D: usize>(n: usize, eta: f64) {
-        let (particles, sim_box) = crate::bench::state::initial_state::<D>(n, eta, 11).expect("a state");
-        let mut sim = Simulation::new(particles, sim_box).expect("a simulation");
-        for _ in 0..20 * n {
-            sim.step().expect("an event");
-        }
+        let sim = run_state::<D>(n, eta, 11);
         let (ps, sim_box, now) = (sim.particles(), sim.sim_box(), sim.time());
         let mut tried = 0;
         for i in 0..ps.len() {
@@ -699,23 +706,12 @@ mod tests {
     /// event, and at the smallest upper end (what a search passes): a skip one ulp too eager
     /// shows at the event's own time.
     fn screened_chunks_match<const D: usize>(n: usize, eta: f64) {
-        let (particles, sim_box) = crate::bench::state::initial_state::<D>(n, eta, 5).expect("a state");
-        let mut sim = Simulation::new(particles, sim_box).expect("a simulation");
-        for _ in 0..20 * n {
-            sim.step().expect("an event");
-        }
+        let sim = run_state::<D>(n, eta, 5);
         let (ps, sim_box, now) = (sim.particles(), sim.sim_box(), sim.time());
         let short = [false; D];
-        let gap = |i: usize, j: usize| -> f64 {
-            let at = |p: &Particle<D>, a: usize| motion::coordinate(p.position[a], p.velocity[a], now - p.time);
-            (0..D)
-                .map(|a| {
-                    let l = sim_box.lengths[a];
-                    let d = at(&ps[j], a) - at(&ps[i], a);
-                    let d = d - l * (d / l).round();
-                    d * d
-                })
-                .sum()
+        let gap = |i: usize, j: usize| {
+            let (a, b) = pair::positions(&ps[i], &ps[j], sim_box, now);
+            (b - a).norm_squared()
         };
         // (A chunk whose pairs all recede gives `[+∞, +∞]` either way: only skips past a
         // contact differ from the brackets.)
