@@ -1,8 +1,8 @@
 //! The g(r) observable in runs: its contact value against the pressure route (exact in
 //! equilibrium), its file, mixtures, interruption, refusals.
 
+use crate::common::{self, collide, scratch};
 use collide::run::{Config, Run};
-use common::{collide, scratch};
 
 fn fluid(dimension: usize, n: usize, eta: f64, seed: u64) -> String {
     let (boundary, placement) = if dimension == 3 { ("periodic", "fcc") } else { ("periodic", "triangular") };
@@ -126,5 +126,3 @@ fn the_rdf_file_mixtures_interruption_and_refusals() {
     assert!(collide(&["run", config.to_str().unwrap(), "--out", plain.to_str().unwrap()]).status.success());
     assert!(!plain.join("rdf.csv").exists());
 }
-
-mod common;

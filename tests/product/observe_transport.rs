@@ -1,9 +1,9 @@
 //! The MSD and VACF observables in runs: the two routes to diffusion agreeing, their files,
 //! mixtures, interruption, refusals and the memory they ask for.
 
+use crate::common::{self, collide, scratch};
 use collide::observe::Observable;
 use collide::run::{Config, Discard, Limits, Run};
-use common::{collide, scratch};
 
 fn fluid(dimension: usize, n: usize, eta: f64, seed: u64) -> String {
     let placement = if dimension == 3 { "fcc" } else { "triangular" };
@@ -150,5 +150,3 @@ fn the_msd_and_vacf_files_mixtures_interruption_and_refusals() {
     assert!(collide(&["run", config.to_str().unwrap(), "--out", plain.to_str().unwrap()]).status.success());
     assert!(!plain.join("msd.csv").exists() && !plain.join("vacf.csv").exists());
 }
-
-mod common;

@@ -4,8 +4,7 @@ use collide::engine::init::{Placement, Species, Velocities, box_for_packing_frac
 use collide::engine::{Boundary, Neighbourhood, Outcome, Particle, ReferenceSimulation, SimBox, Simulation};
 use nalgebra::Vector2;
 
-mod common;
-use common::assert_same_collisions;
+use crate::common::assert_same_collisions;
 
 fn disk(x: f64, y: f64, vx: f64, vy: f64, radius: f64, mass: f64) -> Particle<2> {
     Particle {

@@ -7,8 +7,7 @@ use collide::engine::{Boundary, Neighbourhood, ReferenceSimulation, Simulation};
 use collide::run::output::xyz_frame;
 use collide::run::{Checkpoint, Config, Discard, Run, RunError, Summary};
 
-mod common;
-use common::{assert_same_collisions, reproducible};
+use crate::common::{assert_same_collisions, reproducible};
 
 const EPS: f64 = f64::EPSILON;
 

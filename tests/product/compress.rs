@@ -6,9 +6,8 @@
 use collide::engine::Ending;
 use collide::engine::Outcome;
 
-mod common;
+use crate::common::reproducible;
 use collide::run::{Checkpoint, Config, Phase, Run, Sink, Status, Summary};
-use common::reproducible;
 
 fn config(dimension: usize, n: usize, start: f64, compress: &str, rest: &str) -> Config {
     let text = format!(

@@ -1,4 +1,4 @@
-//! The bad-input suite: one row per case in `tests/bad_input/cases.toml` — the input (a
+//! The bad-input suite: one row per case in `tests/product/bad_input/cases.toml` — the input (a
 //! configuration or an edit of the base one, a checkpoint edit, command-line arguments,
 //! JSON lines, a prepared output directory), the exit status expected, words the error must
 //! contain, and the files that may exist in the output directory afterwards.
@@ -8,10 +8,8 @@
 //! strict JSON on stdout for the JSON-lines rows, and nothing written beyond the files the
 //! row allows.
 
-mod common;
-
+use crate::common::{BASE, strict_json};
 use collide::run::{Checkpoint, Saved};
-use common::{BASE, strict_json};
 use serde::Deserialize;
 use std::collections::BTreeSet;
 use std::io::{Read, Write};
@@ -363,7 +361,8 @@ fn check(case: &Case, root: bool) -> Result<(), String> {
 #[test]
 fn every_bad_input_gets_a_clear_error() {
     let text =
-        std::fs::read_to_string(Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/bad_input/cases.toml")).unwrap();
+        std::fs::read_to_string(Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/product/bad_input/cases.toml"))
+            .unwrap();
     let cases: Cases = toml::from_str(&text).unwrap();
     assert!(cases.case.len() >= 80, "{} rows", cases.case.len());
     let names: BTreeSet<&str> = cases.case.iter().map(|c| c.name.as_str()).collect();

@@ -7,12 +7,10 @@
 //! streams of JSON lines); `COLLIDE_FUZZ_CASES=N` runs N cases of each of the four
 //! properties instead (the long mode: `COLLIDE_FUZZ_CASES=25000` makes 10⁵ in all).
 
-mod common;
-
+use crate::common::{self, BASE};
 use collide::query::numbers::NumberFormat;
 use collide::query::{Query, answer_lines};
 use collide::run::{Checkpoint, Config, Discard, Limits, Run, Saved, Sink, Status};
-use common::BASE;
 use proptest::prelude::*;
 use proptest::test_runner::{Config as ProptestConfig, RngAlgorithm, TestRng, TestRunner};
 use std::cell::Cell;

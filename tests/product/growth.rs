@@ -8,8 +8,7 @@ use collide::engine::{
     SimulationState,
 };
 
-mod common;
-use common::assert_same_collisions;
+use crate::common::assert_same_collisions;
 
 fn system<const D: usize>(
     species: &[Species],

@@ -1,8 +1,6 @@
 //! `collide run` as a user meets it: outputs and their formats, bad input, resume.
 
-mod common;
-
-use common::{BASE, collide, scratch};
+use crate::common::{BASE, collide, scratch};
 use std::path::{Path, PathBuf};
 use std::process::Command;
 
