@@ -114,6 +114,22 @@ impl std::str::FromStr for Neighbourhood {
     }
 }
 
+/// The squared distance from centre `a` to the nearest image of centre `b` in `sim_box`
+/// ([`Neighbours::apart2`]).
+#[inline(always)]
+fn apart2<const D: usize>(sim_box: &SimBox<D>, a: &SVector<f64, D>, b: &SVector<f64, D>) -> f64 {
+    let mut r2 = 0.0;
+    for k in 0..D {
+        let mut x = b[k] - a[k];
+        if sim_box.boundary[k] == Boundary::Periodic {
+            let l = sim_box.lengths[k];
+            x -= (x * (1.0 / l)).round_ties_even() * l;
+        }
+        r2 += x * x;
+    }
+    r2
+}
+
 /// The centres, the lists and the grid of centres — or the grid that follows the particles.
 #[derive(Clone, Debug)]
 pub struct Neighbours<const D: usize> {
@@ -340,16 +356,7 @@ impl<const D: usize> Neighbours<D> {
     /// `x`, and `x` negates exactly), which keeps the lists symmetric.
     #[inline(always)]
     fn apart2(&self, a: &SVector<f64, D>, b: &SVector<f64, D>) -> f64 {
-        let mut r2 = 0.0;
-        for k in 0..D {
-            let mut x = b[k] - a[k];
-            if self.sim_box.boundary[k] == Boundary::Periodic {
-                let l = self.sim_box.lengths[k];
-                x -= (x * (1.0 / l)).round_ties_even() * l;
-            }
-            r2 += x * x;
-        }
-        r2
+        apart2(&self.sim_box, a, b)
     }
 
     /// Lists in `scratch` everyone within range of `i`'s centre. Whether a centre is in range
@@ -357,8 +364,11 @@ impl<const D: usize> Neighbours<D> {
     /// each is written and counted without a branch, into a buffer with room for one more.
     fn scan(&mut self, i: usize) {
         let mut found = std::mem::take(&mut self.scratch);
-        let c = self.centres[i];
         let around = self.cells.around(&self.cell(i));
+        // The box, the range and the centres in locals: through `self`, the compiler read
+        // them again for every member, after each write to `found`.
+        let (sim_box, range2, centres) = (self.sim_box, self.range2, &self.centres[..]);
+        let c = centres[i];
         let mut len = 0;
         self.cells.for_each_member_side_by_side(
             around.as_slice(),
@@ -368,7 +378,7 @@ impl<const D: usize> Neighbours<D> {
                     found.resize(2 * len + 8, 0);
                 }
                 found[len] = j;
-                len += ((j as usize != i) & (self.apart2(&c, &self.centres[j as usize]) < self.range2)) as usize;
+                len += ((j as usize != i) & (apart2(&sim_box, &c, &centres[j as usize]) < range2)) as usize;
             },
         );
         found.truncate(len);
