@@ -114,8 +114,13 @@ impl std::str::FromStr for Neighbourhood {
     }
 }
 
-/// The squared distance from centre `a` to the nearest image of centre `b` in `sim_box`
-/// ([`Neighbours::apart2`]).
+/// The squared distance from centre `a` to the nearest image of centre `b` in `sim_box`.
+/// The image count per periodic axis is `round(x/L)`, as `x·(1/L)` rounded half to even: one
+/// instruction, where [`SimBox::minimum_image_shift`]'s comparisons and branches would
+/// dominate a rebuild's scan of some two dozen centres. Which image wins where `x/L` is
+/// within an ulp of a half does not matter: the range is under half of every periodic length
+/// ([`skin_for`]). The same number from either side (the count is an odd function of `x`,
+/// and `x` negates exactly), which keeps the lists symmetric.
 #[inline(always)]
 fn apart2<const D: usize>(sim_box: &SimBox<D>, a: &SVector<f64, D>, b: &SVector<f64, D>) -> f64 {
     let mut r2 = 0.0;
@@ -344,19 +349,7 @@ impl<const D: usize> Neighbours<D> {
     /// definition, checked by [`check`](Self::check).
     #[inline]
     fn within(&self, i: usize, j: usize) -> bool {
-        self.apart2(&self.centres[i], &self.centres[j]) < self.range2
-    }
-
-    /// The squared distance from centre `a` to the nearest image of centre `b`. The image
-    /// count per periodic axis is `round(x/L)`, as `x·(1/L)` rounded half to even: one
-    /// instruction, where [`SimBox::minimum_image_shift`]'s comparisons and branches would
-    /// dominate a rebuild's scan of some two dozen centres. Which image wins where `x/L` is within an ulp of
-    /// a half does not matter: the range is under half of every periodic length
-    /// ([`skin_for`]). The same number from either side (the count is an odd function of
-    /// `x`, and `x` negates exactly), which keeps the lists symmetric.
-    #[inline(always)]
-    fn apart2(&self, a: &SVector<f64, D>, b: &SVector<f64, D>) -> f64 {
-        apart2(&self.sim_box, a, b)
+        apart2(&self.sim_box, &self.centres[i], &self.centres[j]) < self.range2
     }
 
     /// Lists in `scratch` everyone within range of `i`'s centre. Whether a centre is in range
