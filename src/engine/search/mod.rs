@@ -503,30 +503,19 @@ fn bracket_fields<const D: usize, const W: usize>(
     // image nearest to `i` at `now`.
     let mut separation = [[0.0; W]; D];
     let mut apart = [[0.0; W]; D];
-    // Whether every lane's count was decided by comparisons, reduced in registers (a flag
-    // array stored lane by lane and read back as one vector stalls on store forwarding).
-    let mut decided = true;
-    for k in 0..W {
-        let t = larger(p.time, qt[k]);
-        t0[k] = t;
-        for a in 0..D {
-            let d = motion::coordinate(qx[a][k], qv[a][k], now - qt[k])
-                - motion::coordinate(p.position[a], p.velocity[a], now - p.time);
-            let (count, known) = image_count_by_comparison(d, sim_box.lengths[a]);
-            let periodic = sim_box.boundary[a] == Boundary::Periodic;
-            let count = if periodic { count } else { 0.0 };
-            let at = motion::coordinate(qx[a][k], qv[a][k], t - qt[k])
-                - motion::coordinate(p.position[a], p.velocity[a], t - p.time);
-            first.velocity[a][k] = p.velocity[a];
-            second.position[a][k] = at + count * sim_box.lengths[a];
-            second.velocity[a][k] = qv[a][k];
-            separation[a][k] = d;
-            apart[a][k] = at;
-            decided &= known | !periodic;
-        }
-        first.radius[k] = p.radius;
-        second.radius[k] = qr[k];
+    // When the predicted particle's own time is `now` (the partners of the collision just
+    // resolved: most predictions) and no neighbour's is later, `t₀ = now` in every lane and
+    // the separation at `t₀` is the separation at `now`, the same expression: formed once,
+    // the same bits.
+    let mut fresh = p.time == now;
+    for &t in qt.iter() {
+        fresh &= t <= now;
     }
+    let decided = if fresh {
+        separations::<D, W, true>(p, &qx, &qv, &qt, &qr, sim_box, now, &mut separation, &mut apart, first, second, t0)
+    } else {
+        separations::<D, W, false>(p, &qx, &qv, &qt, &qr, sim_box, now, &mut separation, &mut apart, first, second, t0)
+    };
     // A separation near half a box length (or beyond 3/2) needs the division: rare.
     if !decided {
         for a in 0..D {
@@ -582,6 +571,57 @@ fn bracket_fields<const D: usize, const W: usize>(
         }
     }
     m[0]
+}
+
+/// The balls of [`bracket_fields`]' lanes, as `pair::predict` forms them, and each lane's
+/// separation at `now` and at `t₀` (for the rare count the comparisons leave undecided);
+/// returns whether the comparisons decided every count. `FRESH`: the predicted particle's
+/// own time is `now`, so `t₀ = now` and the separation at `t₀` is the one at `now`.
+#[inline(always)]
+#[allow(clippy::too_many_arguments)]
+fn separations<const D: usize, const W: usize, const FRESH: bool>(
+    p: &Particle<D>,
+    qx: &[[f64; W]; D],
+    qv: &[[f64; W]; D],
+    qt: &[f64; W],
+    qr: &[f64; W],
+    sim_box: &SimBox<D>,
+    now: f64,
+    separation: &mut [[f64; W]; D],
+    apart: &mut [[f64; W]; D],
+    first: &mut BallLanes<D, W>,
+    second: &mut BallLanes<D, W>,
+    t0: &mut [f64; W],
+) -> bool {
+    // Whether every lane's count was decided by comparisons, reduced in registers (a flag
+    // array stored lane by lane and read back as one vector stalls on store forwarding).
+    let mut decided = true;
+    for k in 0..W {
+        let t = if FRESH { now } else { larger(p.time, qt[k]) };
+        t0[k] = t;
+        for a in 0..D {
+            let d = motion::coordinate(qx[a][k], qv[a][k], now - qt[k])
+                - motion::coordinate(p.position[a], p.velocity[a], now - p.time);
+            let (count, known) = image_count_by_comparison(d, sim_box.lengths[a]);
+            let periodic = sim_box.boundary[a] == Boundary::Periodic;
+            let count = if periodic { count } else { 0.0 };
+            let at = if FRESH {
+                d
+            } else {
+                motion::coordinate(qx[a][k], qv[a][k], t - qt[k])
+                    - motion::coordinate(p.position[a], p.velocity[a], t - p.time)
+            };
+            first.velocity[a][k] = p.velocity[a];
+            second.position[a][k] = at + count * sim_box.lengths[a];
+            second.velocity[a][k] = qv[a][k];
+            separation[a][k] = d;
+            apart[a][k] = at;
+            decided &= known | !periodic;
+        }
+        first.radius[k] = p.radius;
+        second.radius[k] = qr[k];
+    }
+    decided
 }
 
 /// The larger of two numbers that are not NaN (as `f64::max`, one vector instruction:
@@ -758,6 +798,70 @@ mod tests {
         // bound itself, that a wrong screen would show.
         assert!(skipped_hits > n, "{skipped_hits} chunks with a contact skipped");
         assert!(kept_at_event > n, "{kept_at_event} chunks kept for an event at the bound");
+    }
+
+    /// A full chunk's lanes hold the balls [`pair::predict`] forms, bit for bit: each lane's
+    /// exact root ([`Lanes::predict`]) is `pair::predict`'s time to the bit, and its bracket
+    /// holds it — whether the predicted particle's own time is earlier than `now` (the
+    /// separations formed at `now` and at `t₀`) or `now` itself (formed once: the partners of
+    /// a collision). Each particle of a run's state against its eight nearest, both ways
+    /// (moved to `now` for the second). A `t₀` or a separation formed at the wrong time moves
+    /// the balls, and the roots with them.
+    fn lanes_hold_pair_predict<const D: usize>(n: usize, eta: f64) {
+        let sim = run_state::<D>(n, eta, 17);
+        let (ps, sim_box, now) = (sim.particles(), sim.sim_box(), sim.time());
+        let short = [false; D];
+        let gap = |i: usize, j: usize| {
+            let (a, b) = pair::positions(&ps[i], &ps[j], sim_box, now);
+            (b - a).norm_squared()
+        };
+        let mut moved = ps.to_vec();
+        let mut contacts = [0usize; 2];
+        for i in 0..ps.len() {
+            let mut others: Vec<usize> = (0..ps.len()).filter(|&j| j != i).collect();
+            others.sort_by(|&a, &b| gap(i, a).total_cmp(&gap(i, b)));
+            let js: [u32; LANES] = core::array::from_fn(|k| others[k] as u32);
+            for fresh in [false, true] {
+                if fresh {
+                    moved[i].advance(now);
+                    assert_eq!(moved[i].time, now);
+                } else if ps[i].time == now {
+                    continue;
+                }
+                let (mut lo, mut hi, mut lanes) = ([0.0; LANES], [0.0; LANES], Lanes::default());
+                bracket_neighbours(&moved, i, &js, LANES, sim_box, now, &mut lo, &mut hi, &mut lanes);
+                for (k, &j) in js.iter().enumerate() {
+                    let want = pair::predict(&moved[i], &moved[j as usize], sim_box, now, &short, Radii::Fixed);
+                    let got = lanes.predict(k, now);
+                    assert_eq!(got.map(f64::to_bits), want.map(f64::to_bits), "particle {i}, lane {k}, fresh {fresh}");
+                    match want {
+                        Some(t) => {
+                            assert!(
+                                lo[k] <= t && t <= hi[k],
+                                "particle {i}, lane {k}: {t} not in [{}, {}]",
+                                lo[k],
+                                hi[k]
+                            );
+                            contacts[fresh as usize] += 1;
+                        }
+                        None => assert_eq!(lo[k], f64::INFINITY, "particle {i}, lane {k}"),
+                    }
+                }
+                moved[i] = ps[i].clone();
+            }
+        }
+        // Enough contacts either way that a wrong ball would show.
+        assert!(contacts[0] > n && contacts[1] > n, "{contacts:?} contacts");
+    }
+
+    #[test]
+    fn lanes_hold_pair_predict_for_disks() {
+        lanes_hold_pair_predict::<2>(400, 0.6);
+    }
+
+    #[test]
+    fn lanes_hold_pair_predict_for_spheres() {
+        lanes_hold_pair_predict::<3>(500, 0.45);
     }
 
     #[test]
