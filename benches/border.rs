@@ -297,7 +297,10 @@ fn range_and_skin() -> (f64, f64) {
 
 /// `n` spheres at `ETA` from the benchmark report's start, warmed up as `collide bench` does.
 fn warmed_up(n: usize) -> Simulation<3> {
-    let (particles, sim_box) = collide::bench::state::initial_state::<3>(n, ETA, 1).expect("a benchmark start");
+    let (particles, sim_box) = collide::bench::state::initial_state::<3>(n, ETA, 1).unwrap_or_else(|e| {
+        eprintln!("border: no benchmark start for N = {n} at η = {ETA}: {e}");
+        std::process::exit(2)
+    });
     let mut sim = Simulation::new(particles, sim_box).expect("a valid start");
     while sim.counts().pair < collide::bench::WARMUP * n as u64 {
         sim.step().expect("events go on");
@@ -757,17 +760,35 @@ fn main() {
         check();
         return;
     }
+    const USAGE: &str = "usage: cargo bench --bench border [-- [N ...] [--ordered] [--events COUNT]]\n\
+        N: particle counts (default 10976 97556); --ordered: only the two-thread run in the order of \
+        time; --events: events timed after the warm-up (default 1000000)";
+    let fail = |what: String| -> ! {
+        eprintln!("border: {what}\n{USAGE}");
+        std::process::exit(2)
+    };
     let mut sizes = Vec::new();
     let mut events = 1_000_000;
     let mut only_ordered = false;
     let mut it = args.iter();
     while let Some(a) = it.next() {
-        if a == "--ordered" {
-            only_ordered = true;
-        } else if a == "--events" {
-            events = it.next().and_then(|v| v.parse().ok()).expect("--events takes a count");
-        } else {
-            sizes.push(a.parse::<usize>().unwrap_or_else(|_| panic!("not a particle count: {a}")));
+        match a.as_str() {
+            "--ordered" => only_ordered = true,
+            "--events" => match it.next() {
+                Some(v) => match v.parse::<u64>() {
+                    Ok(count) if count > 0 => events = count,
+                    _ => fail(format!("--events takes a positive count, not {v:?}")),
+                },
+                None => fail("--events takes a positive count".into()),
+            },
+            "-h" | "--help" => {
+                println!("{USAGE}");
+                return;
+            }
+            _ => match a.parse::<usize>() {
+                Ok(n) if n >= 2 => sizes.push(n),
+                _ => fail(format!("{a:?} is not a particle count (an integer of at least 2) or an option")),
+            },
         }
     }
     if sizes.is_empty() {
