@@ -327,6 +327,50 @@ impl<const D: usize> Cells<D> {
         around
     }
 
+    /// [`around`](Self::around) for a point `x` in cell `m` (as [`locate`](Self::locate)
+    /// puts it), without the cells that cannot hold a centre within `range` of `x`: a cell
+    /// diagonal to `m` whose nearest corner or edge is farther. The cells kept are in
+    /// `around`'s order. A rebuild's scan visits every member of these cells; with cells
+    /// about a range wide, 7–8 of a sphere's 27 are dropped on average (a centre placed
+    /// uniformly in its cell), most of them corners.
+    ///
+    /// Each axis' gap from `x` to the faces of its own cell is shortened by `10⁻⁹` of a
+    /// width (the slack a centre a few ulps over a face is located with, see
+    /// [`WIDTH_SLACK`]); a cell is dropped only when the sum of its squared gaps exceeds
+    /// `range2`, so that no centre in range is dropped whatever the rounding. Away from
+    /// the full stencil (a wall, or fewer than three cells on an axis) every cell is kept.
+    #[inline]
+    pub fn around_within(&self, m: &Coord<D>, x: &SVector<f64, D>, range2: f64) -> Around {
+        let stencil = self.stencil(m);
+        if !stencil.full {
+            return self.around(m);
+        }
+        // The squared gaps to the cells below, at and above `m` along each axis.
+        let mut gap2 = [[0.0f64; 3]; 3];
+        for a in 0..D {
+            let w = self.widths[a];
+            let low = (x[a] * self.inverse[a]).floor() * w;
+            let slack = WIDTH_SLACK * w;
+            let below = (x[a] - low - slack).max(0.0);
+            let above = (low + w - x[a] - slack).max(0.0);
+            gap2[a] = [below * below, 0.0, above * above];
+        }
+        let o = &stencil.offsets;
+        let (ny, nz) = (if D > 1 { 3 } else { 1 }, if D > 2 { 3 } else { 1 });
+        let mut around = Around { cells: [0; 27], len: 0 };
+        for (kz, &z) in o[2][..nz].iter().enumerate() {
+            for (ky, &y) in o[1][..ny].iter().enumerate() {
+                for (kx, &xo) in o[0].iter().enumerate() {
+                    // Written always, kept by the count: whether a corner is in reach is a
+                    // coin toss for the branch predictor.
+                    around.cells[around.len] = (xo + y + z) as u32;
+                    around.len += (gap2[0][kx] + gap2[1][ky] + gap2[2][kz] <= range2) as usize;
+                }
+            }
+        }
+        around
+    }
+
     /// The [`Stencil`] of cell `m`. Away from the walls every axis with three cells or more
     /// gives m − 1, m, m + 1, wrapped by comparison, and the loops over them unroll; next to
     /// a wall, or with fewer than three cells (which wrap onto each other), the distinct ones
@@ -576,6 +620,78 @@ mod tests {
     /// The walk of several cells' lists side by side visits every member of those cells
     /// once (lists of different lengths, empty cells among them), as the walk one cell after
     /// another does.
+    /// `around_within` keeps every cell that holds a point within range of the query point
+    /// (minimum image), drops only cells of `around`, keeps `around`'s order, and drops
+    /// some: query points anywhere and within a few ulps of their cell's faces, probe points
+    /// at random and at one part in 10¹² inside the range in random directions, grids of 3
+    /// to 7 cells a range (and 10⁻⁹) wide per axis, periodic (some axes walled: the
+    /// fallback keeps all), in 2D and 3D.
+    fn within_keeps_every_cell_in_range<const D: usize>(seed: u64) {
+        let mut rng = Xoshiro256PlusPlus::seed_from_u64(seed);
+        let (mut dropped, mut probes) = (0usize, 0usize);
+        for round in 0..80 {
+            let range = rng.random_range(0.5..2.0);
+            let counts: [usize; D] = std::array::from_fn(|_| rng.random_range(3..=7));
+            let boundary: [Boundary; D] = std::array::from_fn(|_| {
+                if round % 4 == 3 && rng.random_range(0..2) == 0 { Boundary::Wall } else { Boundary::Periodic }
+            });
+            let lengths =
+                SVector::<f64, D>::from_fn(|a, _| counts[a] as f64 * range * rng.random_range(1.0 + 2e-9..1.3));
+            let sim_box = SimBox { lengths, boundary };
+            let cells = Cells::new(&sim_box, range, std::iter::empty());
+            let range2 = range * range;
+            for _ in 0..200 {
+                let mut x = SVector::<f64, D>::from_fn(|a, _| rng.random_range(0.0..lengths[a]));
+                // Onto a face of its cell, a few ulps either side, on some axes.
+                for a in 0..D {
+                    if rng.random_range(0..3) == 0 {
+                        let w = cells.widths[a];
+                        let face = (x[a] / w).round() * w;
+                        x[a] = f64::from_bits((face.max(0.0).to_bits() as i64 + rng.random_range(-4..=4)) as u64);
+                        x[a] = x[a].clamp(0.0, lengths[a].next_down());
+                    }
+                }
+                let m = cells.locate(&x);
+                let all = cells.around(&m);
+                let kept = cells.around_within(&m, &x, range2);
+                let order: Vec<usize> = kept
+                    .as_slice()
+                    .iter()
+                    .map(|c| all.as_slice().iter().position(|d| d == c).expect("in around"))
+                    .collect();
+                assert!(order.windows(2).all(|w| w[0] < w[1]), "around's order");
+                dropped += all.as_slice().len() - kept.as_slice().len();
+                for k in 0..64 {
+                    let y = if k % 2 == 0 {
+                        SVector::<f64, D>::from_fn(|a, _| rng.random_range(0.0..lengths[a]))
+                    } else {
+                        let u = SVector::<f64, D>::from_fn(|_, _| rng.random_range(-1.0..1.0));
+                        let y = x + u.normalize() * (range * (1.0 - 1e-12));
+                        SVector::<f64, D>::from_fn(|a, _| match boundary[a] {
+                            Boundary::Periodic => y[a].rem_euclid(lengths[a]),
+                            Boundary::Wall => y[a].clamp(0.0, lengths[a].next_down()),
+                        })
+                    };
+                    if super::super::apart2(&sim_box, &x, &y) < range2 {
+                        probes += 1;
+                        let c = cells.flat(&cells.locate(&y)) as u32;
+                        assert!(
+                            kept.as_slice().contains(&c),
+                            "{y:?} within range of {x:?} in a dropped cell (counts {counts:?}, range {range})"
+                        );
+                    }
+                }
+            }
+        }
+        assert!(dropped > 1000 && probes > 10_000, "{dropped} cells dropped, {probes} probes in range");
+    }
+
+    #[test]
+    fn within_keeps_every_cell_in_range_in_2d_and_3d() {
+        within_keeps_every_cell_in_range::<2>(5);
+        within_keeps_every_cell_in_range::<3>(6);
+    }
+
     #[test]
     fn side_by_side_walk_visits_every_member_once() {
         let sim_box = SimBox { lengths: SVector::from([6.0, 6.0, 6.0]), boundary: [Boundary::Periodic; 3] };

@@ -357,11 +357,14 @@ impl<const D: usize> Neighbours<D> {
     /// each is written and counted without a branch, into a buffer with room for one more.
     fn scan(&mut self, i: usize) {
         let mut found = std::mem::take(&mut self.scratch);
-        let around = self.cells.around(&self.cell(i));
         // The box, the range and the centres in locals: through `self`, the compiler read
         // them again for every member, after each write to `found`.
         let (sim_box, range2, centres) = (self.sim_box, self.range2, &self.centres[..]);
         let c = centres[i];
+        // Only the cells that can hold a centre in range: the members of the others would
+        // all be walked past. The same members found, in the same order (the walk takes
+        // the cells' lists round by round, and a dropped cell adds none).
+        let around = self.cells.around_within(&self.cell(i), &c, range2);
         let mut len = 0;
         self.cells.for_each_member_side_by_side(
             around.as_slice(),
