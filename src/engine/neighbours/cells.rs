@@ -87,20 +87,31 @@ impl Stencil {
     fn for_each<const D: usize>(&self, mut f: impl FnMut(usize)) {
         let o = &self.offsets;
         if self.full {
-            let (ny, nz) = (if D > 1 { 3 } else { 1 }, if D > 2 { 3 } else { 1 });
-            for &z in &o[2][..nz] {
-                for &y in &o[1][..ny] {
-                    for &x in &o[0] {
-                        f(x + y + z);
-                    }
-                }
-            }
+            self.for_each_full::<D>(|_, c| f(c));
         } else {
             for &z in &o[2][..self.lens[2]] {
                 for &y in &o[1][..self.lens[1]] {
                     for &x in &o[0][..self.lens[0]] {
                         f(x + y + z);
                     }
+                }
+            }
+        }
+    }
+}
+
+impl Stencil {
+    /// The full stencil's cells (see [`for_each`](Self::for_each)): `f` gets each cell's
+    /// place on every axis (0 below, 1 at, 2 above the cell around which it is) and its flat
+    /// index, axis 0 fastest. The loops have constant bounds and unroll.
+    #[inline(always)]
+    fn for_each_full<const D: usize>(&self, mut f: impl FnMut([usize; 3], usize)) {
+        let o = &self.offsets;
+        let (ny, nz) = (if D > 1 { 3 } else { 1 }, if D > 2 { 3 } else { 1 });
+        for (kz, &z) in o[2][..nz].iter().enumerate() {
+            for (ky, &y) in o[1][..ny].iter().enumerate() {
+                for (kx, &x) in o[0].iter().enumerate() {
+                    f([kx, ky, kz], x + y + z);
                 }
             }
         }
@@ -355,19 +366,13 @@ impl<const D: usize> Cells<D> {
             let above = (low + w - x[a] - slack).max(0.0);
             gap2[a] = [below * below, 0.0, above * above];
         }
-        let o = &stencil.offsets;
-        let (ny, nz) = (if D > 1 { 3 } else { 1 }, if D > 2 { 3 } else { 1 });
         let mut around = Around { cells: [0; 27], len: 0 };
-        for (kz, &z) in o[2][..nz].iter().enumerate() {
-            for (ky, &y) in o[1][..ny].iter().enumerate() {
-                for (kx, &xo) in o[0].iter().enumerate() {
-                    // Written always, kept by the count: whether a corner is in reach is a
-                    // coin toss for the branch predictor.
-                    around.cells[around.len] = (xo + y + z) as u32;
-                    around.len += (gap2[0][kx] + gap2[1][ky] + gap2[2][kz] <= range2) as usize;
-                }
-            }
-        }
+        stencil.for_each_full::<D>(|[kx, ky, kz], c| {
+            // Written always, kept by the count: whether a corner is in reach is a coin toss
+            // for the branch predictor.
+            around.cells[around.len] = c as u32;
+            around.len += (gap2[0][kx] + gap2[1][ky] + gap2[2][kz] <= range2) as usize;
+        });
         around
     }
 
@@ -616,10 +621,6 @@ mod tests {
         walk::<3>(2);
     }
 
-    /// A gather that does not fit says so instead of writing past `out` or dropping members.
-    /// The walk of several cells' lists side by side visits every member of those cells
-    /// once (lists of different lengths, empty cells among them), as the walk one cell after
-    /// another does.
     /// `around_within` keeps every cell that holds a point within range of the query point
     /// (minimum image), drops only cells of `around`, keeps `around`'s order, and drops
     /// some: query points anywhere and within a few ulps of their cell's faces, probe points
@@ -692,6 +693,9 @@ mod tests {
         within_keeps_every_cell_in_range::<3>(6);
     }
 
+    /// The walk of several cells' lists side by side visits every member of those cells
+    /// once (lists of different lengths, empty cells among them), as the walk one cell after
+    /// another does.
     #[test]
     fn side_by_side_walk_visits_every_member_once() {
         let sim_box = SimBox { lengths: SVector::from([6.0, 6.0, 6.0]), boundary: [Boundary::Periodic; 3] };
@@ -718,6 +722,7 @@ mod tests {
         assert!(lengths.contains(&0) && lengths.iter().any(|&k| k > 5), "{lengths:?}");
     }
 
+    /// A gather that does not fit says so instead of writing past `out` or dropping members.
     #[test]
     fn gather_reports_when_the_members_do_not_fit() {
         let sim_box = SimBox { lengths: SVector::from([10.5, 10.5]), boundary: [Boundary::Periodic; 2] };
