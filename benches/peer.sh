@@ -14,8 +14,13 @@
 #   (N ≤ 20 000) or t = 5 (larger N, which melts sooner in collisions per sphere) for about
 #   T collisions (the end time from the collision rate at η = 0.45, Γ ≈ 28.45 per sphere per
 #   unit time: T/(NΓ/2));
-# * collide: `collide bench-point --dimension 3 --n N --eta 0.45 --warmup 20 --timed T`, the
-#   same N from its own lattice, 20 collisions a sphere of warm-up, T timed collisions.
+# * collide: `collide bench-point --dimension 3 --n N --eta 0.45 --warmup W --timed T`, the
+#   same N from its own lattice, timed from the same time as the peer: W collisions a sphere
+#   of warm-up, the peer's start time times Γ/2 (142 from t = 10, 71 from t = 5), then T
+#   timed collisions. Both codes are timed over the same stretch of their trajectories: the
+#   clock enters the cost of an event time (early in a run a bracket's ends round to two
+#   absolute times more often, and the exact time is pinned), and the melting of the start
+#   is over by then.
 # T is 3·10⁶ below 50 000 spheres and 2·10⁶ from there on. Each round runs both, the order
 # flipped from round to round, pinned to one core where `taskset` exists. The figures to
 # read are the ratios within a round: shared machines drift by a fifth within minutes.
@@ -100,8 +105,8 @@ command -v taskset >/dev/null && pin=(taskset -c 0)
 peer_rate() { # N WARM END
   (cd "$work" && "${pin[@]}" ./Single/md "$1" "$2" "$3" 2>&1 >/dev/null) | sed -n 's/.*: \([0-9.]*\) M\/s$/\1/p'
 }
-collide_rate() { # N T
-  "${pin[@]}" "$collide" bench-point --dimension 3 --n "$1" --eta 0.45 --warmup 20 --timed "$2" |
+collide_rate() { # N W T
+  "${pin[@]}" "$collide" bench-point --dimension 3 --n "$1" --eta 0.45 --warmup "$2" --timed "$3" |
     python3 -c 'import json, sys; print(json.loads(sys.stdin.read().strip().splitlines()[-1])["collisions_per_second"] / 1e6)'
 }
 
@@ -111,10 +116,11 @@ for n in "${sizes[@]}"; do
   if [[ $n -lt 50000 ]]; then timed=3000000; else timed=2000000; fi
   if [[ $n -le 20000 ]]; then warm=10; else warm=5; fi
   end=$(python3 -c "print(round($warm + $timed / ($n * 28.45 / 2), 3))")
+  per_sphere=$(python3 -c "print(round($warm * 28.45 / 2))")
   peers=() ours=()
   for ((r = 0; r < rounds; r++)); do
-    if ((r % 2 == 0)); then p=$(peer_rate "$n" "$warm" "$end"); c=$(collide_rate "$n" "$timed")
-    else c=$(collide_rate "$n" "$timed"); p=$(peer_rate "$n" "$warm" "$end"); fi
+    if ((r % 2 == 0)); then p=$(peer_rate "$n" "$warm" "$end"); c=$(collide_rate "$n" "$per_sphere" "$timed")
+    else c=$(collide_rate "$n" "$per_sphere" "$timed"); p=$(peer_rate "$n" "$warm" "$end"); fi
     [[ -n $p && -n $c ]] || { echo "peer.sh: a run at N = $n gave no rate" >&2; exit 1; }
     echo "  N = $n, round $((r + 1)): peer $p, collide $c" >&2
     peers+=("$p") ours+=("$c")
