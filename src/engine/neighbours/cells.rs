@@ -98,9 +98,7 @@ impl Stencil {
             }
         }
     }
-}
 
-impl Stencil {
     /// The full stencil's cells (see [`for_each`](Self::for_each)): `f` gets each cell's
     /// place on every axis (0 below, 1 at, 2 above the cell around which it is) and its flat
     /// index, axis 0 fastest. The loops have constant bounds and unroll.
