@@ -2,7 +2,7 @@
 # Spheres against Smallenburg's EDMD, side by side: alternating whole processes of the peer
 # and of collide, each timed from inside over its steady state, collisions per second.
 #
-#   benches/peer.sh EDMD_DIR [N ...] [--rounds R] [--collide PATH]
+#   benches/peer.sh EDMD_DIR [N ...] [--rounds R] [--collide PATH] [--threads 2]
 #
 # EDMD_DIR is a checkout of https://github.com/FSmallenburg/EDMD (F. Smallenburg, Eur.
 # Phys. J. E 45, 22 (2022)). Nothing of it enters this repository: its `Single` variant is
@@ -25,13 +25,20 @@
 # flipped from round to round, pinned to one core where `taskset` exists. The figures to
 # read are the ratios within a round: shared machines drift by a fifth within minutes.
 #
+# With `--threads 2` each round also runs collide in two threads (`bench-point --threads 2`:
+# the box in two slabs, a thread each, in the order of time — the same events; pinned to
+# cores 0 and 1), timed to the end time T collisions take, and the table gains its rate and
+# its ratio to the peer's in the same round. The peer runs in one thread: that column
+# compares two cores with one.
+#
 # N must be 4k³ (the peer's FCC start): 2048, 4000, 10976, 32000, 97556, 256000, ...
 set -euo pipefail
 
 usage() {
-  echo "usage: benches/peer.sh EDMD_DIR [N ...] [--rounds R] [--collide PATH]" >&2
+  echo "usage: benches/peer.sh EDMD_DIR [N ...] [--rounds R] [--collide PATH] [--threads 2]" >&2
   echo "  EDMD_DIR: a checkout of github.com/FSmallenburg/EDMD; N: 4k³ spheres (default 10976 97556);" >&2
-  echo "  R: rounds per size (default 4); PATH: the collide binary (default target/release/collide)" >&2
+  echo "  R: rounds per size (default 4); PATH: the collide binary (default target/release/collide);" >&2
+  echo "  --threads 2: collide in two threads as well (the peer runs in one)" >&2
   exit 2
 }
 
@@ -44,6 +51,7 @@ shift
 root=$(cd "$(dirname "$0")/.." && pwd)
 collide="$root/target/release/collide"
 rounds=4
+threads=1
 sizes=()
 while [[ $# -gt 0 ]]; do
   case "$1" in
@@ -53,6 +61,9 @@ while [[ $# -gt 0 ]]; do
     --collide)
       [[ -x ${2:-} ]] || { echo "peer.sh: --collide: '${2:-}' is not an executable" >&2; exit 2; }
       collide=$2; shift 2 ;;
+    --threads)
+      [[ ${2:-} == 2 ]] || { echo "peer.sh: --threads takes 2 (collide in two threads as well), not '${2:-}'" >&2; exit 2; }
+      threads=2; shift 2 ;;
     -h | --help) usage ;;
     *)
       [[ $1 =~ ^[0-9]+$ ]] || { echo "peer.sh: '$1' is not a sphere count or an option" >&2; usage; }
@@ -99,37 +110,53 @@ sub(r"(while \(simtime <= maxtime\)\s*\{\s*step\(\);\s*\})",
 open(path, "w").write(s)
 PY
 make -s -C "$work/Single" >/dev/null
-pin=()
-command -v taskset >/dev/null && pin=(taskset -c 0)
+pin=() pin2=()
+command -v taskset >/dev/null && pin=(taskset -c 0) pin2=(taskset -c 0,1)
 
 peer_rate() { # N WARM END
   (cd "$work" && "${pin[@]}" ./Single/md "$1" "$2" "$3" 2>&1 >/dev/null) | sed -n 's/.*: \([0-9.]*\) M\/s$/\1/p'
 }
-collide_rate() { # N W T
-  "${pin[@]}" "$collide" bench-point --dimension 3 --n "$1" --eta 0.45 --warmup "$2" --timed "$3" |
+collide_rate() { # N W T [THREADS]
+  local threads=${4:-1} cores=("${pin[@]}")
+  [[ $threads == 2 ]] && cores=("${pin2[@]}")
+  "${cores[@]}" "$collide" bench-point --dimension 3 --n "$1" --eta 0.45 --warmup "$2" --timed "$3" --threads "$threads" |
     python3 -c 'import json, sys; print(json.loads(sys.stdin.read().strip().splitlines()[-1])["collisions_per_second"] / 1e6)'
 }
 
-echo "| N | rounds | peer, 10⁶/s: median (range) | collide, 10⁶/s | collide / peer, round by round: median (range) |"
-echo "|---|---|---|---|---|"
+if [[ $threads == 2 ]]; then
+  echo "| N | rounds | peer, 10⁶/s: median (range) | collide, 10⁶/s | collide / peer, round by round: median (range) | collide in two threads, 10⁶/s | two threads / peer |"
+  echo "|---|---|---|---|---|---|---|"
+else
+  echo "| N | rounds | peer, 10⁶/s: median (range) | collide, 10⁶/s | collide / peer, round by round: median (range) |"
+  echo "|---|---|---|---|---|"
+fi
 for n in "${sizes[@]}"; do
   if [[ $n -lt 50000 ]]; then timed=3000000; else timed=2000000; fi
   if [[ $n -le 20000 ]]; then warm=10; else warm=5; fi
   end=$(python3 -c "print(round($warm + $timed / ($n * 28.45 / 2), 3))")
   per_sphere=$(python3 -c "print(round($warm * 28.45 / 2))")
-  peers=() ours=()
+  peers=() ours=() twos=()
   for ((r = 0; r < rounds; r++)); do
-    if ((r % 2 == 0)); then p=$(peer_rate "$n" "$warm" "$end"); c=$(collide_rate "$n" "$per_sphere" "$timed")
-    else c=$(collide_rate "$n" "$per_sphere" "$timed"); p=$(peer_rate "$n" "$warm" "$end"); fi
-    [[ -n $p && -n $c ]] || { echo "peer.sh: a run at N = $n gave no rate" >&2; exit 1; }
-    echo "  N = $n, round $((r + 1)): peer $p, collide $c" >&2
-    peers+=("$p") ours+=("$c")
+    c2=
+    if ((r % 2 == 0)); then
+      p=$(peer_rate "$n" "$warm" "$end"); c=$(collide_rate "$n" "$per_sphere" "$timed")
+      [[ $threads == 2 ]] && c2=$(collide_rate "$n" "$per_sphere" "$timed" 2)
+    else
+      [[ $threads == 2 ]] && c2=$(collide_rate "$n" "$per_sphere" "$timed" 2)
+      c=$(collide_rate "$n" "$per_sphere" "$timed"); p=$(peer_rate "$n" "$warm" "$end")
+    fi
+    [[ -n $p && -n $c && ( $threads == 1 || -n $c2 ) ]] || { echo "peer.sh: a run at N = $n gave no rate" >&2; exit 1; }
+    echo "  N = $n, round $((r + 1)): peer $p, collide $c${c2:+, collide in two threads $c2}" >&2
+    peers+=("$p") ours+=("$c") twos+=("${c2:-0}")
   done
-  python3 - "$n" "${peers[*]}" "${ours[*]}" <<'PY'
+  python3 - "$n" "$threads" "${peers[*]}" "${ours[*]}" "${twos[*]}" <<'PY'
 import statistics, sys
-n, peer, ours = sys.argv[1], [float(x) for x in sys.argv[2].split()], [float(x) for x in sys.argv[3].split()]
-ratios = [c / p for p, c in zip(peer, ours)]
+n, threads = sys.argv[1], sys.argv[2]
+peer, ours, twos = ([float(x) for x in a.split()] for a in sys.argv[3:6])
 f = lambda xs, d, bold="": f"{bold}{statistics.median(xs):.{d}f}{bold} ({min(xs):.{d}f}–{max(xs):.{d}f})"
-print(f"| {n} | {len(ratios)} | {f(peer, 3)} | {f(ours, 3)} | {f(ratios, 2, '**')} |")
+row = f"| {n} | {len(peer)} | {f(peer, 3)} | {f(ours, 3)} | {f([c / p for p, c in zip(peer, ours)], 2, '**')} |"
+if threads == "2":
+    row += f" {f(twos, 3)} | {f([c / p for p, c in zip(peer, twos)], 2, '**')} |"
+print(row)
 PY
 done

@@ -67,6 +67,11 @@ enum Command {
         seed: u64,
         #[arg(long, default_value_t = Neighbourhood::Auto)]
         neighbourhood: Neighbourhood,
+        /// 1: the whole box in one thread; 2: two slabs, a thread each, in the order of
+        /// time (the same events), timed to the end time `--timed` collisions take at the
+        /// rate of the warm-up's second half.
+        #[arg(long, default_value_t = 1)]
+        threads: usize,
     },
     /// The hardware's floor for one point, without and with its lookahead (JSON lines).
     #[command(hide = true)]
@@ -293,8 +298,9 @@ fn run(cli: Cli) -> Result<ExitCode> {
         Command::Validate(args) => validate(args),
         Command::Check => check(),
         Command::Bench(args) => bench(args),
-        Command::BenchPoint { dimension, n, eta, warmup, timed, seed, neighbourhood } => {
-            let point = collide::bench::measure(dimension as usize, n, eta, neighbourhood, warmup, timed, seed)?;
+        Command::BenchPoint { dimension, n, eta, warmup, timed, seed, neighbourhood, threads } => {
+            let point =
+                collide::bench::measure(dimension as usize, n, eta, neighbourhood, warmup, timed, seed, threads)?;
             say!("{}", serde_json::to_string(&point)?);
             Ok(ExitCode::SUCCESS)
         }

@@ -4,7 +4,9 @@
 //! Each point builds a periodic box of disks or spheres from a lattice ([`state`]; Maxwell
 //! velocities, kT = 1), runs a warm-up that is not timed (so the lattice has melted and the
 //! queue has reached its working size), then times a fixed number of pair collisions on one
-//! core. Memory is
+//! core — or, with two threads, on the box divided between two
+//! ([`Divided::run_ordered`](crate::engine::Divided::run_ordered), the whole box's events bit
+//! for bit). Memory is
 //! reported twice: the engine's own account of its heap (capacities of the particle array,
 //! the event queue, the neighbour lists and their grid) and the process's peak resident set size when each point
 //! runs in a process of its own (`collide bench` does that).
@@ -14,7 +16,7 @@ pub mod state;
 
 pub use state::{BenchError, initial_state};
 
-use crate::engine::{EventCounts, Neighbourhood, Simulation};
+use crate::engine::{Divided, EventCounts, Lead, Neighbourhood, Simulation};
 use crate::lab::plot::{Chart, Series};
 use serde::{Deserialize, Serialize};
 use std::time::Instant;
@@ -35,9 +37,16 @@ pub struct BenchPoint {
     /// Whether neighbour lists were in use (else the grid that follows the particles).
     #[serde(default)]
     pub lists: bool,
+    /// Threads the timed collisions ran in: 1, the whole box; 2, the box divided in two
+    /// slabs across the first axis, a thread each, in the order of time
+    /// ([`Divided::run_ordered`](crate::engine::Divided::run_ordered): the same events as
+    /// one thread, bit for bit).
+    #[serde(default = "one")]
+    pub threads: usize,
     /// Untimed warm-up collisions.
     pub warmup_collisions: u64,
-    /// Timed pair collisions.
+    /// Timed pair collisions (with two threads, those before the end time that `--timed`
+    /// asked for: see [`measure`]).
     pub collisions: u64,
     /// Timed wall-clock seconds.
     pub seconds: f64,
@@ -78,6 +87,10 @@ fn two() -> usize {
     2
 }
 
+fn one() -> usize {
+    1
+}
+
 /// The process's peak resident set size (Linux `VmHWM`), if readable.
 pub fn peak_rss_bytes() -> Option<u64> {
     let status = std::fs::read_to_string("/proc/self/status").ok()?;
@@ -87,7 +100,16 @@ pub fn peak_rss_bytes() -> Option<u64> {
 }
 
 /// Measures one point in `d` dimensions (2 or 3): `warmup_per_particle` untimed collisions
-/// per particle, then `timed` collisions, with the neighbourhood asked for.
+/// per particle, then `timed` collisions, with the neighbourhood asked for, in `threads`
+/// threads.
+///
+/// With one thread the timed stretch ends at the `timed`-th collision. With two, the warmed-up
+/// box is divided ([`Divided`]) and run in the order of time up to an end time, the clock
+/// after the warm-up plus `timed / ν`, where ν is the collisions per unit time over the
+/// second half of the warm-up: about `timed` collisions once the start has melted, and
+/// `collisions` says how many. Two threads need a warm-up (`warmup_per_particle ≥ 1`) to
+/// know ν.
+#[allow(clippy::too_many_arguments)]
 pub fn measure(
     d: usize,
     n: usize,
@@ -96,12 +118,67 @@ pub fn measure(
     warmup_per_particle: u64,
     timed: u64,
     seed: u64,
+    threads: usize,
 ) -> Result<BenchPoint, BenchError> {
+    if !(1..=2).contains(&threads) {
+        return Err(BenchError::Option {
+            flag: "threads",
+            value: threads.to_string(),
+            allowed: "1 (the whole box) or 2 (two slabs, a thread each, in the order of time)",
+        });
+    }
+    if threads == 2 && warmup_per_particle == 0 {
+        return Err(BenchError::Option {
+            flag: "warmup",
+            value: "0".into(),
+            allowed: "at least 1 with --threads 2 (the warm-up's collision rate sets the end time)",
+        });
+    }
     match d {
-        2 => measure_in::<2>(n, eta, neighbourhood, warmup_per_particle, timed, seed),
-        3 => measure_in::<3>(n, eta, neighbourhood, warmup_per_particle, timed, seed),
+        2 => measure_in::<2>(n, eta, neighbourhood, warmup_per_particle, timed, seed, threads),
+        3 => measure_in::<3>(n, eta, neighbourhood, warmup_per_particle, timed, seed, threads),
         _ => Err(BenchError::Option { flag: "dimension", value: d.to_string(), allowed: "2 (disks) or 3 (spheres)" }),
     }
+}
+
+/// What the timed stretch of a point gave.
+struct Timed {
+    seconds: f64,
+    counts: EventCounts,
+    engine_bytes: usize,
+    crowded: usize,
+    lists: bool,
+}
+
+/// The timed stretch in one thread: `timed` collisions of `sim`.
+fn timed_whole<const D: usize>(mut sim: Simulation<D>, timed: u64) -> Result<Timed, BenchError> {
+    let before = sim.counts();
+    let start = Instant::now();
+    let target = before.pair + timed;
+    while sim.counts().pair < target {
+        sim.step().ok_or(BenchError::Stopped)?;
+    }
+    let seconds = start.elapsed().as_secs_f64();
+    let counts = sim.counts().since(&before);
+    Ok(Timed { seconds, counts, engine_bytes: sim.memory_bytes(), crowded: sim.crowded(), lists: sim.lists() })
+}
+
+/// The timed stretch in two threads: `sim` divided where it stands
+/// ([`Divided::from_simulation`]) and run in the order of time until `end` (every item before
+/// it); the divided box, for a test to compare.
+fn timed_divided<const D: usize>(sim: Simulation<D>, end: f64) -> Result<(Timed, Divided<D>), BenchError> {
+    let mut divided = Divided::from_simulation(sim).map_err(BenchError::Setup)?;
+    let start = Instant::now();
+    divided.run_ordered(end, Lead::Free);
+    let seconds = start.elapsed().as_secs_f64();
+    let timed = Timed {
+        seconds,
+        counts: divided.counts(),
+        engine_bytes: divided.memory_bytes(),
+        crowded: divided.crowded(),
+        lists: divided.lists(),
+    };
+    Ok((timed, divided))
 }
 
 fn measure_in<const D: usize>(
@@ -111,41 +188,47 @@ fn measure_in<const D: usize>(
     warmup_per_particle: u64,
     timed: u64,
     seed: u64,
+    threads: usize,
 ) -> Result<BenchPoint, BenchError> {
     let (particles, sim_box) = initial_state::<D>(n, eta, seed)?;
     let mut sim = Simulation::with_neighbourhood(particles, sim_box, neighbourhood).map_err(BenchError::Setup)?;
     let warmup = warmup_per_particle * n as u64;
+    // The clock and count halfway through the warm-up: the rate of its second half (the
+    // lattice melted) sets the end time of a run in two threads.
+    let mut halfway = (0.0, 0);
     while sim.counts().pair < warmup {
         sim.step().ok_or(BenchError::Stopped)?;
+        if halfway.1 == 0 && 2 * sim.counts().pair >= warmup {
+            halfway = (sim.time(), sim.counts().pair);
+        }
     }
-    let before = sim.counts();
-    let start = Instant::now();
-    let target = before.pair + timed;
-    while sim.counts().pair < target {
-        sim.step().ok_or(BenchError::Stopped)?;
-    }
-    let seconds = start.elapsed().as_secs_f64();
-    let events_by_kind = sim.counts().since(&before);
-    let (engine_bytes, crowded, lists) = (sim.memory_bytes(), sim.crowded(), sim.lists());
+    let Timed { seconds, counts: events_by_kind, engine_bytes, crowded, lists } = if threads == 2 {
+        let rate = (sim.counts().pair - halfway.1) as f64 / (sim.time() - halfway.0);
+        let end = sim.time() + timed as f64 / rate;
+        timed_divided(sim, end)?.0
+    } else {
+        timed_whole(sim, timed)?
+    };
     // Read before the floor allocates; the engine's memory goes first.
     let (peak_rss_bytes, huge_page_bytes) = (peak_rss_bytes(), crate::engine::internals::huge_page_bytes());
-    drop(sim);
     // (The floor needs full rows of neighbours: none below two particles' worth of rows.)
     let floor = (n >= 2 * floor::rows(D) * floor::WIDTH)
         .then(|| floor::measure::<D>(n, eta, 2 * n as u64, timed, seed))
         .transpose()?;
-    let collisions_per_second = timed as f64 / seconds;
+    let collisions = events_by_kind.pair;
+    let collisions_per_second = collisions as f64 / seconds;
     Ok(BenchPoint {
         dimension: D,
         n_particles: n,
         packing_fraction: eta,
         neighbourhood,
         lists,
+        threads,
         warmup_collisions: warmup,
-        collisions: timed,
+        collisions,
         seconds,
         collisions_per_second,
-        ns_per_collision: seconds * 1e9 / timed as f64,
+        ns_per_collision: seconds * 1e9 / collisions as f64,
         events_per_second: events_by_kind.total() as f64 / seconds,
         events_by_kind,
         engine_bytes_per_particle: engine_bytes as f64 / n as f64,
@@ -268,5 +351,60 @@ pub fn chart(points: &[BenchPoint]) -> Chart {
                 std::iter::once(engine).chain(floor)
             })
             .collect(),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The timed stretch in two threads runs the whole box's events, bit for bit: the same
+    /// collisions, rebuilds and particles as one thread going on to the same end (spheres
+    /// with lists, disks with the grid; only the re-prediction markers differ, as the divided
+    /// box predicts every particle again where it starts). Fails if the divided box starts
+    /// from anything but the warmed-up state, or if the end time is not honoured.
+    #[test]
+    fn two_threads_run_the_whole_box_events() {
+        fn check<const D: usize>(n: usize, eta: f64, neighbourhood: Neighbourhood) {
+            let (particles, sim_box) = initial_state::<D>(n, eta, 7).expect("a start");
+            let mut sim = Simulation::with_neighbourhood(particles, sim_box, neighbourhood).expect("valid");
+            while sim.counts().pair < 3 * n as u64 {
+                sim.step().expect("events go on");
+            }
+            let mut whole = sim.clone();
+            let before = whole.counts();
+            for _ in 0..30_000 {
+                whole.step().expect("events go on");
+            }
+            let went = whole.counts().since(&before);
+            // Every item before the end in two threads, then the event at the end.
+            let (timed, mut divided) = timed_divided(sim, whole.time()).expect("divided");
+            divided.step().expect("events go on");
+            let c = divided.counts();
+            assert_eq!((c.pair, c.wall, c.rebuild), (went.pair, went.wall, went.rebuild), "{D}D: the counts differ");
+            assert!(timed.counts.pair > 0 && timed.counts.pair < went.pair);
+            assert!(timed.seconds > 0.0 && timed.engine_bytes > 0);
+            assert_eq!(timed.lists, neighbourhood != Neighbourhood::Grid);
+            let same = divided
+                .particles()
+                .iter()
+                .zip(whole.particles())
+                .all(|(a, b)| a.position == b.position && a.velocity == b.velocity && a.time == b.time);
+            assert!(same, "{D}D: the particles differ");
+        }
+        check::<3>(2048, 0.45, Neighbourhood::Auto);
+        check::<2>(2000, 0.65, Neighbourhood::Grid);
+    }
+
+    /// Threads other than one or two, and two without a warm-up, are refused by name.
+    #[test]
+    fn threads_are_one_or_two() {
+        let refused = |threads, warmup| match measure(3, 500, 0.4, Neighbourhood::Auto, warmup, 10, 1, threads) {
+            Err(BenchError::Option { flag, .. }) => flag,
+            other => panic!("not refused: {other:?}"),
+        };
+        assert_eq!(refused(0, 1), "threads");
+        assert_eq!(refused(3, 1), "threads");
+        assert_eq!(refused(2, 0), "warmup");
     }
 }

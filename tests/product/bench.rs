@@ -17,8 +17,8 @@ fn bench_point_table_and_chart() {
     // Both neighbourhoods can be asked for; the point records which one ran, and both see
     // the same collisions (bit-identical trajectories), so the same event counts but for
     // the neighbourhood updates themselves.
-    let lists = measure(2, 300, 0.6, Neighbourhood::Lists, 1, 5_000, 1).unwrap();
-    let p = measure(2, 300, 0.6, Neighbourhood::Grid, 1, 5_000, 1).unwrap();
+    let lists = measure(2, 300, 0.6, Neighbourhood::Lists, 1, 5_000, 1, 1).unwrap();
+    let p = measure(2, 300, 0.6, Neighbourhood::Grid, 1, 5_000, 1, 1).unwrap();
     assert!(lists.lists && !p.lists && lists.neighbourhood == Neighbourhood::Lists);
     assert_eq!((lists.events_by_kind.pair, lists.events_by_kind.wall), (p.events_by_kind.pair, p.events_by_kind.wall));
     assert_ne!(lists.events_by_kind.rebuild, p.events_by_kind.rebuild);
@@ -40,7 +40,7 @@ fn bench_point_table_and_chart() {
     q.n_particles = 3_000;
     q.packing_fraction = 0.3;
     // Spheres: their own series, with a floor of their own.
-    let s = measure(3, 500, 0.45, Neighbourhood::Auto, 1, 5_000, 1).unwrap();
+    let s = measure(3, 500, 0.45, Neighbourhood::Auto, 1, 5_000, 1, 1).unwrap();
     assert_eq!((s.dimension, s.events_by_kind.pair), (3, 5_000));
     let (floor, fraction) = (s.floor_collisions_per_second.unwrap(), s.fraction_of_floor.unwrap());
     assert!(floor > 0.0 && (fraction - s.collisions_per_second / floor).abs() <= 1e-12 * fraction);
@@ -63,7 +63,7 @@ fn bench_point_table_and_chart() {
     let svg = std::fs::read_to_string(dir.join("c.svg")).unwrap();
     assert!(svg.contains("log₁₀ N") && svg.contains("floor, disks, η = 0.6"));
     // A dimension other than 2 or 3, and a packing fraction past close packing of spheres.
-    assert!(measure(4, 500, 0.3, Neighbourhood::Auto, 1, 10, 1).unwrap_err().to_string().contains("--dimension 4"));
-    let err = measure(3, 500, 0.75, Neighbourhood::Auto, 1, 10, 1).unwrap_err().to_string();
+    assert!(measure(4, 500, 0.3, Neighbourhood::Auto, 1, 10, 1, 1).unwrap_err().to_string().contains("--dimension 4"));
+    let err = measure(3, 500, 0.75, Neighbourhood::Auto, 1, 10, 1, 1).unwrap_err().to_string();
     assert!(err.contains("π/√18"), "{err}");
 }

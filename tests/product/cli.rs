@@ -137,6 +137,27 @@ fn check_verifies_the_reference_cases() {
     assert!(!stdout.contains("MISMATCH"));
 }
 
+/// A point timed in two threads says so, and runs the same events as one thread would: the
+/// same kinds of events in the same proportions (the exact equality, event by event, is the
+/// engine's own test, `bench::tests`).
+#[test]
+fn bench_point_runs_in_two_threads() {
+    let args =
+        ["bench-point", "--dimension", "3", "--n", "2048", "--eta", "0.45", "--warmup", "20", "--timed", "20000"];
+    let out = collide(&[&args[..], &["--threads", "2"]].concat(), "");
+    assert!(out.status.success(), "{}", text(&out.stderr));
+    let point: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    assert_eq!(point["threads"].as_u64(), Some(2));
+    let collisions = point["collisions"].as_u64().unwrap();
+    // The end time comes from the rate of the warm-up's second half: about the collisions
+    // asked for (19 881 with this seed).
+    assert!((19_000..21_000).contains(&collisions), "{collisions} collisions for 20 000 asked");
+    assert_eq!(point["events_by_kind"]["pair"].as_u64(), Some(collisions));
+    let out = collide(&args, "");
+    let point: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    assert_eq!((point["threads"].as_u64(), point["collisions"].as_u64()), (Some(1), Some(20_000)));
+}
+
 /// The benchmark's neighbourhood can be forced; a name that is not one is refused with the
 /// names allowed, before anything runs or is written.
 #[test]

@@ -189,7 +189,7 @@ impl<const D: usize> Neighbours<D> {
 
     /// Whether particle `i` (with lists) is crowded.
     #[inline]
-    fn is_crowded(&self, i: usize) -> bool {
+    pub(crate) fn is_crowded(&self, i: usize) -> bool {
         lists::crowded(self.rows(i))
     }
 

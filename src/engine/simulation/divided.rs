@@ -709,7 +709,21 @@ impl<const D: usize> Divided<D> {
         sim_box: SimBox<D>,
         params: EngineParams,
     ) -> Result<Self, SetupError> {
-        let whole = Simulation::with_params(particles, sim_box, params)?;
+        Self::from_simulation(Simulation::with_params(particles, sim_box, params)?)
+    }
+
+    /// A running simulation divided from where it stands: its particles, box, clock and
+    /// tunables, every particle predicted again (the same events from here on — predictions
+    /// are exact — though not the same re-prediction markers), the counts from zero. A state
+    /// taken mid-run can hold pairs in contact overlapping by rounding, which [`new`](Self::new)
+    /// refuses; here they are the engine's own. A simulation that samples or grows is refused
+    /// ([`SetupError::BadState`]): a divided box does neither.
+    pub fn from_simulation(whole: Simulation<D>) -> Result<Self, SetupError> {
+        if whole.growth.is_some() || whole.holds_until.is_some() || whole.sampling.predict().is_some() {
+            return Err(SetupError::BadState { what: "a simulation that samples or grows cannot be divided".into() });
+        }
+        let mut whole = whole;
+        whole.counts = EventCounts::default();
         let time = whole.time;
         let anchors = || whole.particles.iter().map(|p| p.position_at(time)[0]).collect();
         let zone = whole.neighbours.read_reach(0);
@@ -787,6 +801,24 @@ impl<const D: usize> Divided<D> {
         let owner = &self.sides[0].region.as_deref().expect("divided").owner;
         let upper = owner.iter().filter(|&&s| s == Side::Upper).count();
         [owner.len() - upper, upper]
+    }
+
+    /// The engine's heap, both sides' (each holds a replica of every record).
+    pub fn memory_bytes(&self) -> usize {
+        self.sides.iter().map(Simulation::memory_bytes).sum()
+    }
+
+    /// How many particles are crowded (see [`Simulation::crowded`]), each counted by the
+    /// side that owns it; none with the grid.
+    pub fn crowded(&self) -> usize {
+        let crowded =
+            |s: &Simulation<D>| (0..s.particles.len()).filter(|&k| s.owns(k) && s.neighbours.is_crowded(k)).count();
+        if self.lists() { self.sides.iter().map(crowded).sum() } else { 0 }
+    }
+
+    /// Whether neighbour lists are in use (else the grid).
+    pub fn lists(&self) -> bool {
+        self.sides[0].lists()
     }
 
     /// Events so far, both sides'.
