@@ -108,7 +108,8 @@ pub fn peak_rss_bytes() -> Option<u64> {
 /// after the warm-up plus `timed / ν`, where ν is the collisions per unit time over the
 /// second half of the warm-up: about `timed` collisions once the start has melted, and
 /// `collisions` says how many. Two threads need a warm-up (`warmup_per_particle ≥ 1`) to
-/// know ν.
+/// know ν, and a machine (or an affinity mask) with two cores: on one, the two threads would
+/// spin through each other's time slices.
 #[allow(clippy::too_many_arguments)]
 pub fn measure(
     d: usize,
@@ -125,6 +126,14 @@ pub fn measure(
             flag: "threads",
             value: threads.to_string(),
             allowed: "1 (the whole box) or 2 (two slabs, a thread each, in the order of time)",
+        });
+    }
+    // Two threads on one core spin through each other's time slices: refused, not crawled.
+    if threads == 2 && std::thread::available_parallelism().is_ok_and(|cores| cores.get() < 2) {
+        return Err(BenchError::Option {
+            flag: "threads",
+            value: "2".into(),
+            allowed: "1 only: this process may run on one core (its CPU affinity), where two threads would wait out each other's time slices",
         });
     }
     if threads == 2 && warmup_per_particle == 0 {
