@@ -137,9 +137,9 @@ fn check_verifies_the_reference_cases() {
     assert!(!stdout.contains("MISMATCH"));
 }
 
-/// A point timed in two threads says so, and runs the same events as one thread would: the
-/// same kinds of events in the same proportions (the exact equality, event by event, is the
-/// engine's own test, `bench::tests`).
+/// A point timed in two threads says so and times about the collisions asked for; pinned to
+/// one core it is refused. (That its events are one thread's, bit for bit, is the library's
+/// test `bench::tests::two_threads_run_the_whole_box_events`.)
 #[test]
 fn bench_point_runs_in_two_threads() {
     let args =

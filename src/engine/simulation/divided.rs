@@ -718,11 +718,10 @@ impl<const D: usize> Divided<D> {
     /// taken mid-run can hold pairs in contact overlapping by rounding, which [`new`](Self::new)
     /// refuses; here they are the engine's own. A simulation that samples or grows is refused
     /// ([`SetupError::BadState`]): a divided box does neither.
-    pub fn from_simulation(whole: Simulation<D>) -> Result<Self, SetupError> {
+    pub fn from_simulation(mut whole: Simulation<D>) -> Result<Self, SetupError> {
         if whole.growth.is_some() || whole.holds_until.is_some() || whole.sampling.predict().is_some() {
             return Err(SetupError::BadState { what: "a simulation that samples or grows cannot be divided".into() });
         }
-        let mut whole = whole;
         whole.counts = EventCounts::default();
         let time = whole.time;
         let anchors = || whole.particles.iter().map(|p| p.position_at(time)[0]).collect();
