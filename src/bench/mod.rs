@@ -368,10 +368,11 @@ mod tests {
     use super::*;
 
     /// The timed stretch in two threads runs the whole box's events, bit for bit: the same
-    /// collisions, rebuilds and particle records (every field) as one thread going on to the same end (spheres
-    /// with lists, disks with the grid; only the re-prediction markers differ, as the divided
-    /// box predicts every particle again where it starts). Fails if the divided box starts
-    /// from anything but the warmed-up state, or if the end time is not honoured.
+    /// collisions, rebuilds and particle records (every field) as one thread going on to the
+    /// same end (spheres with lists, disks with the grid; only the re-prediction markers
+    /// differ, as the divided box predicts every particle again where it starts). Fails if the
+    /// divided box starts from anything but the warmed-up state, or if the end time is not
+    /// honoured.
     #[test]
     fn two_threads_run_the_whole_box_events() {
         fn check<const D: usize>(n: usize, eta: f64, neighbourhood: Neighbourhood) {
