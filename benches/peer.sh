@@ -32,6 +32,10 @@
 # compares two cores with one.
 #
 # N must be 4k³ (the peer's FCC start): 2048, 4000, 10976, 32000, 97556, 256000, ...
+#
+# `--build-only DIR` builds the edited peer into DIR/md (run as `md N WARM END`) and stops;
+# `--march ARCH` builds it for ARCH instead of the Makefile's `native` (`benches/count.sh`
+# counts it on `x86-64-v3`, which valgrind simulates).
 set -euo pipefail
 
 usage() {
@@ -39,6 +43,7 @@ usage() {
   echo "  EDMD_DIR: a checkout of github.com/FSmallenburg/EDMD; N: 4k³ spheres (default 10976 97556);" >&2
   echo "  R: rounds per size (default 4); PATH: the collide binary (default target/release/collide);" >&2
   echo "  --threads 2: collide in two threads as well (the peer runs in one)" >&2
+  echo "  --build-only DIR: build the edited peer into DIR/md and stop; --march ARCH: build it for ARCH" >&2
   exit 2
 }
 
@@ -53,6 +58,8 @@ collide="$root/target/release/collide"
 rounds=4
 threads=1
 sizes=()
+build_only=
+march=
 while [[ $# -gt 0 ]]; do
   case "$1" in
     --rounds)
@@ -64,6 +71,12 @@ while [[ $# -gt 0 ]]; do
     --threads)
       [[ ${2:-} == 2 ]] || { echo "peer.sh: --threads takes 2 (collide in two threads as well), not '${2:-}'" >&2; exit 2; }
       threads=2; shift 2 ;;
+    --build-only)
+      [[ -d ${2:-} ]] || { echo "peer.sh: --build-only: '${2:-}' is not a directory" >&2; exit 2; }
+      build_only=$2; shift 2 ;;
+    --march)
+      [[ ${2:-} =~ ^[A-Za-z0-9_.-]+$ ]] || { echo "peer.sh: --march takes a gcc -march value, not '${2:-}'" >&2; exit 2; }
+      march=$2; shift 2 ;;
     -h | --help) usage ;;
     *)
       [[ $1 =~ ^[0-9]+$ ]] || { echo "peer.sh: '$1' is not a sphere count or an option" >&2; usage; }
@@ -73,7 +86,8 @@ while [[ $# -gt 0 ]]; do
   esac
 done
 [[ ${#sizes[@]} -gt 0 ]] || sizes=(10976 97556)
-[[ -x $collide ]] || { echo "peer.sh: $collide not built: run cargo build --release --locked first" >&2; exit 2; }
+[[ -n $build_only || -x $collide ]] ||
+  { echo "peer.sh: $collide not built: run cargo build --release --locked first" >&2; exit 2; }
 
 work=$(mktemp -d)
 trap 'rm -rf "$work"' EXIT
@@ -109,7 +123,17 @@ sub(r"(while \(simtime <= maxtime\)\s*\{\s*step\(\);\s*\})",
     " (colcounter - peer_c0) / (peer_w1 - peer_w0) / 1e6);")
 open(path, "w").write(s)
 PY
-make -s -C "$work/Single" >/dev/null
+if [[ -n $march ]]; then
+  # The Makefile's flags with the target changed.
+  flags=$(sed -n 's/^CFLAGS *= *//p' "$work/Single/Makefile" | sed "s/-march=[^ ]*/-march=$march/")
+  make -s -C "$work/Single" CFLAGS="$flags" >/dev/null
+else
+  make -s -C "$work/Single" >/dev/null
+fi
+if [[ -n $build_only ]]; then
+  cp "$work/Single/md" "$build_only/md"
+  exit 0
+fi
 pin=() pin2=()
 command -v taskset >/dev/null && pin=(taskset -c 0) pin2=(taskset -c 0,1)
 
