@@ -40,6 +40,7 @@ usage() {
 }
 
 root=$(cd "$(dirname "$0")/.." && pwd)
+. "$root/benches/spheres.sh"
 valgrind=valgrind
 length=200000
 edmd=
@@ -58,9 +59,7 @@ while [[ $# -gt 0 ]]; do
       valgrind=$2; shift 2 ;;
     -h | --help) usage ;;
     *)
-      [[ $1 =~ ^[0-9]+$ ]] || { echo "count.sh: '$1' is not a sphere count or an option" >&2; usage; }
-      k=$(python3 -c "n=$1; k=round((n/4)**(1/3)); print(k if n>0 and 4*k**3==n else 0)")
-      [[ $k -gt 0 ]] || { echo "count.sh: N = $1 is not 4k³ (the peer's FCC start): try 4000, 10976, 32000 or 97556" >&2; exit 2; }
+      fcc_count count.sh "$1" || { echo "count.sh: '$1' is not a sphere count or an option" >&2; usage; }
       sizes+=("$1"); shift ;;
   esac
 done
@@ -138,9 +137,11 @@ PY
 echo "| code | N | collisions apart | instructions | data reads + writes | level-1 read misses | last-level read misses | conditional branches | mispredicted |"
 echo "|---|---|---|---|---|---|---|---|---|"
 for n in "${sizes[@]}"; do
-  if [[ $n -le 20000 ]]; then warm=10; else warm=5; fi
-  per_sphere=$(python3 -c "print(round($warm * 28.45 / 2))")
+  warm=$(start_time "$n")
+  per_sphere=$(start_per_sphere "$n")
   runs=()
+  # A checkpoint for each run, the same state with a different run length (a resumed run
+  # keeps its configuration's length): both runs then start and end the same way.
   for len in "$length" $((2 * length)); do
     cat > "$work/c$len.toml" <<EOF
 dimension = 3
@@ -171,7 +172,7 @@ EOF
   if [[ -n $edmd ]]; then
     peer=() done=()
     for len in "$length" $((2 * length)); do
-      end=$(python3 -c "print($warm + $len / ($n * 28.45 / 2))")
+      end=$(end_time "$n" "$len")
       echo "count.sh: the peer, N = $n, about $len collisions under cachegrind ..." >&2
       (cd "$work" && "${pin[@]}" "${cg[@]}" --cachegrind-out-file="$work/cgp$len" ./md "$n" "$warm" "$end" >/dev/null 2>"$work/logp$len") ||
         { echo "count.sh: cachegrind failed on the peer; its log:" >&2; tail -n 20 "$work/logp$len" >&2; exit 1; }

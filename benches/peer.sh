@@ -54,6 +54,7 @@ shift
 [[ -f "$edmd/Single/mdSingle.c" && -f "$edmd/Single/Makefile" ]] ||
   { echo "peer.sh: $edmd: no Single/mdSingle.c and Single/Makefile (a checkout of FSmallenburg/EDMD?)" >&2; exit 2; }
 root=$(cd "$(dirname "$0")/.." && pwd)
+. "$root/benches/spheres.sh"
 collide="$root/target/release/collide"
 rounds=4
 threads=1
@@ -79,9 +80,7 @@ while [[ $# -gt 0 ]]; do
       march=$2; shift 2 ;;
     -h | --help) usage ;;
     *)
-      [[ $1 =~ ^[0-9]+$ ]] || { echo "peer.sh: '$1' is not a sphere count or an option" >&2; usage; }
-      k=$(python3 -c "n=$1; k=round((n/4)**(1/3)); print(k if n>0 and 4*k**3==n else 0)")
-      [[ $k -gt 0 ]] || { echo "peer.sh: N = $1 is not 4k³ (the peer's FCC start): try 4000, 10976, 32000 or 97556" >&2; exit 2; }
+      fcc_count peer.sh "$1" || { echo "peer.sh: '$1' is not a sphere count or an option" >&2; usage; }
       sizes+=("$1"); shift ;;
   esac
 done
@@ -156,9 +155,9 @@ else
 fi
 for n in "${sizes[@]}"; do
   if [[ $n -lt 50000 ]]; then timed=3000000; else timed=2000000; fi
-  if [[ $n -le 20000 ]]; then warm=10; else warm=5; fi
-  end=$(python3 -c "print(round($warm + $timed / ($n * 28.45 / 2), 3))")
-  per_sphere=$(python3 -c "print(round($warm * 28.45 / 2))")
+  warm=$(start_time "$n")
+  end=$(end_time "$n" "$timed" 3)
+  per_sphere=$(start_per_sphere "$n")
   peers=() ours=() twos=()
   for ((r = 0; r < rounds; r++)); do
     c2=
