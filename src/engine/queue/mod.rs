@@ -329,6 +329,65 @@ mod tests {
         }
     }
 
+    /// The two owners of one pair event (each holding the pair, at the same time) have the
+    /// same key; the tree then takes the one in the left subtree, as a tournament of pairs
+    /// in which the left one wins ties — at every level, whether two, three or four children
+    /// tie (some at `+∞`), and whatever else is pending (checked against that tournament
+    /// played out over the tree's positions). Which owner comes first decides which partner
+    /// a step resolves from, so the tie must fall the same way in every build.
+    #[test]
+    fn the_tree_breaks_equal_keys_to_the_left() {
+        let pair = |time: f64, partner: usize| Event {
+            time,
+            kind: EventKind::Pair { partner: partner as u32, partner_events: 0 },
+        };
+        let mut rng = Xoshiro256PlusPlus::seed_from_u64(23);
+        let mut lower_lost = 0;
+        for n in [4usize, 5, 16, 17, 64, 300] {
+            let mut queue = EventQueue::new((0..n).map(|_| Event::NOTHING).collect(), QueueKind::Tree);
+            let EventQueue::Tree(tree) = &queue else { unreachable!() };
+            let m = tree.internal_nodes();
+            for _ in 0..(60_000 / n).max(300) {
+                // A background of events at +∞ and at 3, 4 and 5: many share a time.
+                for k in 0..n {
+                    let r: u32 = rng.random_range(0..4);
+                    queue.set(k, if r == 0 { Event::NOTHING } else { wall(2.0 + r as f64) });
+                }
+                let (p, q) = (rng.random_range(0..n), rng.random_range(0..n));
+                if p == q {
+                    continue;
+                }
+                // At t = 3 walls share the time, but a pair ranks before them.
+                let t = if rng.random_range(0..2) == 0 { 1.0 } else { 3.0 };
+                queue.set(q, pair(t, p));
+                queue.set(p, pair(t, q));
+                // The tournament over positions: node `k`'s children are `4k + 1 … 4k + 4`,
+                // slot `s` is position `m + s` (those past the particles hold nothing).
+                fn play(queue: &EventQueue, m: usize, n: usize, k: usize) -> (usize, Event) {
+                    if k >= m {
+                        let s = k - m;
+                        return (s, if s < n { queue.get(s) } else { Event::NOTHING });
+                    }
+                    let mut best = play(queue, m, n, 4 * k + 1);
+                    for c in 4 * k + 2..4 * k + 5 {
+                        let other = play(queue, m, n, c);
+                        if other.1.before(other.0 as u32, &best.1, best.0 as u32) {
+                            best = other;
+                        }
+                    }
+                    best
+                }
+                let (want, _) = if m == 0 { (0, Event::NOTHING) } else { play(&queue, m, n, 0) };
+                let (first, event) = queue.first();
+                assert_eq!((first, event.time), (want, t), "n = {n}, pair {p}, {q}");
+                assert!(first == p || first == q, "n = {n}, pair {p}, {q}");
+                lower_lost += (first != p.min(q)) as usize;
+            }
+        }
+        // The left subtree is not always the lower slot (slots lie on two levels).
+        assert!(lower_lost > 0);
+    }
+
     /// Against a linear scan: the tree's `guess_next(a, b)` is at least as early as every
     /// particle outside the subtrees of `a` and `b` that it leaves out (`guess_levels`
     /// levels up, never above the top three levels), and where neither subtree holds the

@@ -8,9 +8,10 @@
 //! nodes. The slots are padded with at most two empty ones so that every internal node has
 //! four children, which makes `m = (slots − 1)/3` — about N/3 nodes of 16 bytes. Each
 //! internal node keeps the time and owner of the earliest event below it, so replacing one
-//! particle's event walks one path of ⌈log₄ N⌉ nodes, comparing the four children of each
-//! node on it as two independent pairs. Against a binary tree, an update costs about the
-//! same and the tree takes a third of the memory (N/3 nodes instead of N).
+//! particle's event walks one path of ⌈log₄ N⌉ nodes, taking the earliest of the four
+//! children of each node on it by their smallest time (the full key only on a tie). Against
+//! a binary tree, an update costs about the same and the tree takes a third of the memory
+//! (N/3 nodes instead of N).
 //! The four children of a node share one cache line (see [`Tree`]): 16 bytes per
 //! particle for the events and about 5 for the nodes.
 //!
@@ -186,12 +187,12 @@ impl Tree {
         while k > 0 {
             k = (k - 1) / ARITY;
             let best = self.children_winner(k);
-            let old = self.node(k);
+            let node = if k == 0 { &mut self.root } else { &mut self.quads[(k - 1) / ARITY].0[(k - 1) % ARITY] };
             // Another particle still wins here, at the same time: nothing above changes.
-            if old.owner == best.owner && old.owner != owner as u32 && old.time == best.time {
+            if node.owner == best.owner && node.owner != owner as u32 && node.time == best.time {
                 return;
             }
-            self.set_node(k, best);
+            *node = best;
         }
     }
 
@@ -231,8 +232,8 @@ impl Tree {
         while (x | y) != 0 {
             let parent = (x.max(y) - 1) / ARITY;
             let c = ARITY * parent + 1;
-            for ch in c..c + ARITY {
-                let Node { time, owner } = self.winner(ch);
+            let four = self.children(parent);
+            for (ch, Node { time, owner }) in (c..c + ARITY).zip(four) {
                 let time = if ch == x || ch == y { f64::INFINITY } else { time };
                 best_owner = std::hint::select_unpredictable(time < best_time, owner, best_owner);
                 best_time = best_time.min(time);
@@ -279,8 +280,7 @@ impl Tree {
         self.groups.capacity() * size_of::<Group>() + self.quads.capacity() * size_of::<Quad>()
     }
 
-    /// The earliest event below internal node `k`, from its four children: two independent
-    /// pairs, then their winners.
+    /// The earliest event below internal node `k`, from its four children ([`earliest_of`]).
     ///
     /// The four children are all slots (the level above the slots) or all internal nodes,
     /// except under at most one node; the two common cases read them as one line each.
@@ -288,18 +288,46 @@ impl Tree {
     fn children_winner(&self, k: usize) -> Node {
         let c = ARITY * k + 1;
         let m = self.m;
-        let [w, x, y, z] = if c >= m {
+        if c >= m {
             let first = c - m;
             let g = &self.groups[(first + self.shift) / ARITY].0;
-            let leaf = |o: usize| Node { time: g[o].time, owner: (first + o) as u32 };
-            [leaf(0), leaf(1), leaf(2), leaf(3)]
+            match earliest_of([g[0].time, g[1].time, g[2].time, g[3].time]) {
+                Ok((time, lane)) => Node { time, owner: (first + lane) as u32 },
+                Err(tied) => {
+                    let leaf = |o: usize| Node { time: g[o].time, owner: (first + o) as u32 };
+                    self.tie_among([leaf(0), leaf(1), leaf(2), leaf(3)], tied)
+                }
+            }
+        } else if c + ARITY <= m {
+            let q = &self.quads[k].0;
+            match earliest_of([q[0].time, q[1].time, q[2].time, q[3].time]) {
+                Ok((time, lane)) => Node { time, owner: q[lane].owner },
+                Err(tied) => self.tie_among(*q, tied),
+            }
+        } else {
+            let q = self.children(k);
+            match earliest_of(q.map(|n| n.time)) {
+                Ok((time, lane)) => Node { time, owner: q[lane].owner },
+                Err(tied) => self.tie_among(q, tied),
+            }
+        }
+    }
+
+    /// The four children of internal node `k`, as [`children_winner`](Self::children_winner)
+    /// reads them.
+    #[inline(always)]
+    fn children(&self, k: usize) -> [Node; ARITY] {
+        let c = ARITY * k + 1;
+        let m = self.m;
+        if c >= m {
+            let first = c - m;
+            let g = &self.groups[(first + self.shift) / ARITY].0;
+            core::array::from_fn(|o| Node { time: g[o].time, owner: (first + o) as u32 })
         } else if c + ARITY <= m {
             self.quads[k].0
         } else {
-            [self.winner(c), self.winner(c + 1), self.winner(c + 2), self.winner(c + 3)]
-        };
-        let (a, b) = (self.earlier(w, x), self.earlier(y, z));
-        self.earlier(a, b)
+            core::array::from_fn(|o| self.winner(c + o))
+        }
     }
 
     /// The earliest event below tree position `k` (a node or a slot).
@@ -313,15 +341,20 @@ impl Tree {
         }
     }
 
-    /// The earlier of two nodes. Which one wins is a coin toss for the branch predictor, so
-    /// the choice is a select; equal times (rare) take the branch to the full key.
-    #[inline(always)]
-    fn earlier(&self, a: Node, b: Node) -> Node {
-        let b_first = if a.time == b.time { self.tie_b_first(a, b) } else { b.time < a.time };
-        // The winner's time is the smaller one (equal times are equal as f64, whichever wins
-        // the tie), so no branch picks it: written as an `if`, the compiler branches on it (it
-        // has no conditional move for an f64), and those branches mispredict half the time.
-        Node { time: a.time.min(b.time), owner: std::hint::select_unpredictable(b_first, b.owner, a.owner) }
+    /// The earliest of the four nodes whose lanes are set in `tied` (at least two, sharing
+    /// the smallest time), by the full key; among equal keys (the two owners of one pair
+    /// event) the lowest lane — as a tournament of pairs in which the left one wins ties.
+    #[cold]
+    #[inline(never)]
+    fn tie_among(&self, four: [Node; ARITY], tied: u32) -> Node {
+        let mut lanes = (0..ARITY).filter(|&k| tied & (1 << k) != 0);
+        let mut best = four[lanes.next().expect("two tied lanes")];
+        for k in lanes {
+            if self.tie_b_first(best, four[k]) {
+                best = four[k];
+            }
+        }
+        best
     }
 
     #[cold]
@@ -330,4 +363,24 @@ impl Tree {
         let key = |x: Node| self.slot(x.owner as usize).unpack().key(x.owner);
         key(b) < key(a)
     }
+}
+
+/// The smallest of four times and its lane; or, when two or more lanes hold it, those lanes
+/// as a bit mask (`Err`), for the full key to decide — the two owners of one pair event
+/// meeting in a node, or children with nothing pending (`+∞`). Each lane is compared once,
+/// with the minimum, and the one branch is on a tie, where a tournament of pairs compared
+/// each pair twice, for a tie and for the order (a replacement's walk up the tree takes a
+/// sixth fewer instructions, `benches/HISTORY.md`). Times are never NaN.
+#[inline(always)]
+fn earliest_of(t: [f64; ARITY]) -> Result<(f64, usize), u32> {
+    let low = smaller(smaller(t[0], t[1]), smaller(t[2], t[3]));
+    let tied =
+        (t[0] == low) as u32 | ((t[1] == low) as u32) << 1 | ((t[2] == low) as u32) << 2 | ((t[3] == low) as u32) << 3;
+    if tied & (tied - 1) == 0 { Ok((low, tied.trailing_zeros() as usize)) } else { Err(tied) }
+}
+
+/// The smaller of two times that are not NaN: one instruction (`f64::min` also orders NaN).
+#[inline(always)]
+fn smaller(a: f64, b: f64) -> f64 {
+    if a < b { a } else { b }
 }
