@@ -128,7 +128,7 @@ impl Tree {
     fn build_nodes(&mut self) {
         for k in (0..self.m).rev() {
             let best = self.children_winner(k);
-            self.set_node(k, best);
+            *self.node_mut(k) = best;
         }
     }
 
@@ -150,13 +150,10 @@ impl Tree {
         if k == 0 { self.root } else { self.quads[(k - 1) / ARITY].0[(k - 1) % ARITY] }
     }
 
+    /// Internal node `k < m`, to replace.
     #[inline(always)]
-    fn set_node(&mut self, k: usize, node: Node) {
-        if k == 0 {
-            self.root = node;
-        } else {
-            self.quads[(k - 1) / ARITY].0[(k - 1) % ARITY] = node;
-        }
+    fn node_mut(&mut self, k: usize) -> &mut Node {
+        if k == 0 { &mut self.root } else { &mut self.quads[(k - 1) / ARITY].0[(k - 1) % ARITY] }
     }
 
     /// The pending events, by owner.
@@ -187,7 +184,7 @@ impl Tree {
         while k > 0 {
             k = (k - 1) / ARITY;
             let best = self.children_winner(k);
-            let node = if k == 0 { &mut self.root } else { &mut self.quads[(k - 1) / ARITY].0[(k - 1) % ARITY] };
+            let node = self.node_mut(k);
             // Another particle still wins here, at the same time: nothing above changes.
             if node.owner == best.owner && node.owner != owner as u32 && node.time == best.time {
                 return;
@@ -282,8 +279,10 @@ impl Tree {
 
     /// The earliest event below internal node `k`, from its four children ([`earliest_of`]).
     ///
-    /// The four children are all slots (the level above the slots) or all internal nodes,
-    /// except under at most one node; the two common cases read them as one line each.
+    /// The cases of [`children`](Self::children), each taking the winner's owner where it
+    /// is (a slot's from its lane, a node's from the line): through `children`' array the
+    /// four nodes went to the stack and back, which counted more instructions a replacement
+    /// (`benches/HISTORY.md`).
     #[inline(always)]
     fn children_winner(&self, k: usize) -> Node {
         let c = ARITY * k + 1;
@@ -313,8 +312,9 @@ impl Tree {
         }
     }
 
-    /// The four children of internal node `k`, as [`children_winner`](Self::children_winner)
-    /// reads them.
+    /// The four children of internal node `k`. They are all slots (the level above the
+    /// slots) or all internal nodes, except under at most one node; the two common cases read
+    /// them as one line each.
     #[inline(always)]
     fn children(&self, k: usize) -> [Node; ARITY] {
         let c = ARITY * k + 1;
